@@ -1,0 +1,50 @@
+"""Frozen dataclasses registered as JAX pytrees.
+
+Array-valued fields are pytree leaves (so ``jax.grad`` reaches material parameters); fields declared
+with ``static_field()`` are metadata (sizes, names, kinds) that become part of the compiled
+program's identity, as in MJX ``dataclasses.py``.
+"""
+from __future__ import annotations
+
+import dataclasses
+from typing import Any
+
+import jax
+import numpy as np
+
+
+def static_field(**kwargs: Any) -> Any:
+    """A dataclass field that is static metadata, not a pytree leaf."""
+    metadata = dict(kwargs.pop("metadata", {}))
+    metadata["static"] = True
+    return dataclasses.field(metadata=metadata, **kwargs)
+
+
+def pytree_dataclass(cls: type) -> type:
+    """Make ``cls`` a frozen dataclass and register it with ``jax.tree_util``."""
+    cls = dataclasses.dataclass(frozen=True)(cls)
+    data, meta = [], []
+    for f in dataclasses.fields(cls):
+        (meta if f.metadata.get("static", False) else data).append(f.name)
+    return jax.tree_util.register_dataclass(cls, data_fields=data, meta_fields=meta)
+
+
+def is_concrete(*values: Any) -> bool:
+    """True when every value is a concrete number or array (not a tracer, not a pytree sentinel).
+
+    Constructors validate user values only when this holds, so that validation happens where
+    a law is built from user input and never while JAX rebuilds the object during tracing.
+    """
+    for v in values:
+        if isinstance(v, jax.core.Tracer):
+            return False
+        if not isinstance(v, (int, float, np.ndarray, np.generic, jax.Array)) or isinstance(v, bool):
+            return False
+    return True
+
+
+def as_leaf(value: Any) -> Any:
+    """Normalise a user-given number: Python numbers become float, arrays are kept as they are."""
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return float(value)
+    return value

@@ -1,0 +1,50 @@
+"""The ``jaxform`` command. Host side only: argument parsing, files, printing.
+
+Each sub-command lives in its own module with ``add_parser(subparsers)`` registering itself and a
+``run(args) -> int`` doing the work; this module only wires them together.
+"""
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+# Sub-command modules, in the order ``jaxform --help`` lists them.
+_COMMANDS = ("demo", "cases", "run", "wrinkles")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(
+        prog="jaxform",
+        description="Differentiable forming simulation of engineering fabrics (JAX).",
+    )
+    from jaxform import __version__
+
+    parser.add_argument("--version", action="version", version=f"jaxform {__version__}")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    for name in _COMMANDS:
+        try:
+            module = importlib.import_module(f"jaxform.cli.{name}")
+        except ModuleNotFoundError as err:  # a sub-command not built yet in this checkout
+            if err.name == f"jaxform.cli.{name}":
+                continue
+            raise
+        module.add_parser(sub)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    try:
+        return int(args.handler(args) or 0)
+    except (ValueError, FileNotFoundError, FileExistsError) as err:
+        print(f"jaxform {args.command}: error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,1 @@
+"""Host-side plotting with matplotlib (Agg backend). Kernels never import this package."""

@@ -21,12 +21,36 @@ def static_field(**kwargs: Any) -> Any:
 
 
 def pytree_dataclass(cls: type) -> type:
-    """Make ``cls`` a frozen dataclass and register it with ``jax.tree_util``."""
+    """Make ``cls`` a frozen dataclass and register it with ``jax.tree_util``.
+
+    JAX rebuilds the object (after ``jit``, ``vmap``, ``grad``, ``tree_map``) without calling
+    ``__init__``: ``__post_init__`` validation runs only when a user constructs the object, never
+    on tracers, cotangents (which may be negative) or pytree sentinels.
+    """
     cls = dataclasses.dataclass(frozen=True)(cls)
     data, meta = [], []
     for f in dataclasses.fields(cls):
         (meta if f.metadata.get("static", False) else data).append(f.name)
-    return jax.tree_util.register_dataclass(cls, data_fields=data, meta_fields=meta)
+    data, meta = tuple(data), tuple(meta)
+    keys = tuple(jax.tree_util.GetAttrKey(n) for n in data)
+
+    def flatten_with_keys(obj):
+        children = tuple((k, getattr(obj, n)) for k, n in zip(keys, data))
+        return children, tuple(getattr(obj, n) for n in meta)
+
+    def flatten(obj):
+        return tuple(getattr(obj, n) for n in data), tuple(getattr(obj, n) for n in meta)
+
+    def unflatten(aux, children):
+        obj = object.__new__(cls)
+        for n, v in zip(data, children):
+            object.__setattr__(obj, n, v)
+        for n, v in zip(meta, aux):
+            object.__setattr__(obj, n, v)
+        return obj
+
+    jax.tree_util.register_pytree_with_keys(cls, flatten_with_keys, unflatten, flatten)
+    return cls
 
 
 def is_concrete(*values: Any) -> bool:
@@ -36,6 +60,10 @@ def is_concrete(*values: Any) -> bool:
     a law is built from user input and never while JAX rebuilds the object during tracing.
     """
     for v in values:
+        if isinstance(v, (list, tuple)):
+            if not is_concrete(*v):
+                return False
+            continue
         if isinstance(v, jax.core.Tracer):
             return False
         if not isinstance(v, (int, float, np.ndarray, np.generic, jax.Array)) or isinstance(v, bool):

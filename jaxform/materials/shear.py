@@ -9,10 +9,14 @@ section 2). The laws here are generic and fittable; the paper's two fabrics are 
   shear only (``positive_only=True``, the NCF stitch term) or odd-symmetrically.
 * :class:`CompositeShear` — the sum of several laws (NCF = yarn rotation + stitch).
 
-Each law offers ``force(gamma)`` (N/m), ``tangent(gamma) = dF/dgamma`` (N/m per rad) and
-``energy(gamma) = ∫_0^gamma F dg`` (J/m²). How the shell turns ``F_norm`` into a stress is the
-shell's business (see ``jaxform.shell``); the paper's reading is a tangent shear modulus
-``G12(gamma) = F_norm(gamma) / h`` (eq. A.14).
+Each law offers ``force(gamma)`` (N/m), ``tangent(gamma) = dF/dgamma`` (N/m per rad),
+``integral(gamma) = ∫_0^gamma F dg`` (N/m·rad = J/m²) and
+``integral2(gamma) = ∫_0^|gamma| integral(g) dg`` (J/m²·rad). Both integrals are even in
+``gamma`` for odd laws (and zero for ``gamma < 0`` for positive-only terms). How the shell turns
+``F_norm`` into a stress is the shell's business (see ``jaxform.shell``): if ``F_norm`` is read as
+the shear force conjugate to ``gamma`` the shear energy per area is ``integral``; the paper's
+reading is a tangent shear modulus ``G12(gamma) = F_norm(gamma) / h`` (eq. A.14), whose shear
+stress resultant is ``sign(gamma) * integral(gamma)`` and whose energy is ``integral2``.
 
 All laws are pytrees of arrays, differentiable in every coefficient and finite at ``gamma = 0``.
 """
@@ -69,11 +73,17 @@ class PolynomialShear:
         i = jnp.arange(1, self.degree + 1)
         return jnp.sum(self.coeffs * i * self._powers(a, -1), axis=-1)
 
-    def energy(self, gamma):
+    def integral(self, gamma):
         """``∫_0^gamma F dg``, J/m² (even in ``gamma``)."""
         a, _ = _split_sign(gamma)
         i = jnp.arange(1, self.degree + 1)
         return jnp.sum(self.coeffs / (i + 1) * self._powers(a, 1), axis=-1)
+
+    def integral2(self, gamma):
+        """``∫_0^|gamma| integral(g) dg``, J/m²·rad (even in ``gamma``)."""
+        a, _ = _split_sign(gamma)
+        i = jnp.arange(1, self.degree + 1)
+        return jnp.sum(self.coeffs / ((i + 1) * (i + 2)) * self._powers(a, 2), axis=-1)
 
 
 @pytree_dataclass
@@ -145,7 +155,7 @@ class PiecewiseLinearShear:
 
         return self._sided(gamma, t, odd=False)
 
-    def energy(self, gamma):
+    def integral(self, gamma):
         """``∫_0^gamma F dg``, J/m²."""
 
         def e(a):
@@ -154,6 +164,18 @@ class PiecewiseLinearShear:
             return jnp.sum(x * (f0 + 0.5 * slope * x), axis=-1)
 
         return self._sided(gamma, e, odd=False)
+
+    def integral2(self, gamma):
+        """``∫_0^|gamma| integral(g) dg``, J/m²·rad."""
+
+        def e2(a):
+            a, g0, g1, f0, slope, _ = self._segments(a)
+            x = jnp.clip(a, g0, g1) - g0
+            full = (g1 - g0) * (f0 + 0.5 * slope * (g1 - g0))  # whole segment's integral
+            beyond = jnp.maximum(a - g1, 0.0)
+            return jnp.sum(0.5 * f0 * x**2 + slope * x**3 / 6.0 + full * beyond, axis=-1)
+
+        return self._sided(gamma, e2, odd=False)
 
 
 @pytree_dataclass
@@ -168,7 +190,7 @@ class CompositeShear:
 
     def __post_init__(self):
         terms = tuple(self.terms)
-        if not terms or not all(hasattr(t, "force") and hasattr(t, "energy") for t in terms):
+        if not terms or not all(hasattr(t, "force") and hasattr(t, "integral") for t in terms):
             raise ValueError(f"CompositeShear.terms = {self.terms!r}: must be a non-empty tuple of shear laws")
         object.__setattr__(self, "terms", terms)
 
@@ -178,8 +200,11 @@ class CompositeShear:
     def tangent(self, gamma):
         return sum(t.tangent(gamma) for t in self.terms)
 
-    def energy(self, gamma):
-        return sum(t.energy(gamma) for t in self.terms)
+    def integral(self, gamma):
+        return sum(t.integral(gamma) for t in self.terms)
+
+    def integral2(self, gamma):
+        return sum(t.integral2(gamma) for t in self.terms)
 
 
 ShearLaw = PolynomialShear | PiecewiseLinearShear | CompositeShear

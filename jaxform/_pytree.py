@@ -72,7 +72,14 @@ def is_concrete(*values: Any) -> bool:
 
 
 def as_leaf(value: Any) -> Any:
-    """Normalise a user-given number: Python numbers become float, arrays are kept as they are."""
+    """Normalise a user-given value: Python numbers become float, sequences become arrays
+    (numpy when concrete, JAX when they hold tracers), arrays are kept as they are."""
     if isinstance(value, (int, float)) and not isinstance(value, bool):
         return float(value)
+    if isinstance(value, (list, tuple)):
+        if is_concrete(*value):
+            return np.asarray(value, dtype=np.float64)
+        import jax.numpy as jnp
+
+        return jnp.stack([jnp.asarray(v) for v in value])
     return value

@@ -28,7 +28,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform import validate
-from jaxform._pytree import is_concrete, pytree_dataclass, static_field
+from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.materials.bending import _split_sign
 
 
@@ -43,6 +43,7 @@ class PolynomialShear:
     coeffs: Any
 
     def __post_init__(self):
+        object.__setattr__(self, "coeffs", as_leaf(self.coeffs))
         if is_concrete(self.coeffs):
             arr = np.asarray(self.coeffs, dtype=np.float64)
             if arr.ndim != 1 or arr.size == 0:
@@ -105,6 +106,8 @@ class PiecewiseLinearShear:
     positive_only: bool = static_field(default=True)
 
     def __post_init__(self):
+        object.__setattr__(self, "gamma_knots", as_leaf(self.gamma_knots))
+        object.__setattr__(self, "force_knots", as_leaf(self.force_knots))
         if is_concrete(self.gamma_knots, self.force_knots):
             g = np.asarray(self.gamma_knots, dtype=np.float64)
             f = np.asarray(self.force_knots, dtype=np.float64)

@@ -1,0 +1,5 @@
+import sys
+
+from jaxform.cli import main
+
+sys.exit(main())

@@ -1,0 +1,42 @@
+"""Output directories: never overwrite what a user gave us.
+
+``prepare_output_dir`` creates a directory for results, refuses a non-empty directory unless the
+caller says ``force`` (or the directory carries the marker of an earlier run of the same command,
+which the command owns and may replace), and leaves a marker so a re-run can recognise it.
+"""
+from __future__ import annotations
+
+import pathlib
+
+MARKER = ".jaxform-output"
+
+
+def prepare_output_dir(path, *, force: bool = False, owner: str = "jaxform") -> pathlib.Path:
+    """Create or reuse an output directory.
+
+    Args:
+        path: directory to write into.
+        force: allow writing into a non-empty directory that this command did not create.
+        owner: name of the command writing there (recorded in the marker file).
+
+    Returns:
+        The directory as a ``pathlib.Path``.
+
+    Raises:
+        FileExistsError: when ``path`` is a file, or a non-empty directory not created by
+            ``owner`` and ``force`` is not set.
+    """
+    out = pathlib.Path(path)
+    if out.exists() and not out.is_dir():
+        raise FileExistsError(f"output path {out} exists and is a file; choose a directory")
+    marker = out / MARKER
+    if out.exists() and any(out.iterdir()) and not force:
+        ours = marker.exists() and marker.read_text().strip() == owner
+        if not ours:
+            raise FileExistsError(
+                f"output directory {out} is not empty and was not written by 'jaxform {owner}'; "
+                "choose another directory or pass --force to write into it"
+            )
+    out.mkdir(parents=True, exist_ok=True)
+    marker.write_text(owner + "\n")
+    return out

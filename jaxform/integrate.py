@@ -1,0 +1,248 @@
+"""Explicit central-difference integration of the fabric shell.
+
+``step(model, state) -> state`` advances one time step; :func:`rollout` scans it (``lax.scan``),
+saving a frame every ``every`` steps, with ``jax.checkpoint`` on each chunk of ``every`` steps so
+that reverse mode through thousands of steps stores only the frames (memory ~ frames + one chunk).
+:func:`simulate` is the host-side driver: it jits the rollout, checks the run's health and raises
+:class:`SimulationError` (with the frames up to the last good one) when it failed.
+
+Central differences with lumped mass (velocities at half steps)::
+
+    a_n     = (f_int(x_n) + m g + f_loads(x_n, v_{n-1/2}, t_n) - c m v_{n-1/2}) / m
+    v_{n+½} = v_{n-½} + dt a_n           (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
+    x_{n+1} = x_n + dt v_{n+½}
+
+Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/4 m (|v_{n-½}|² + |v_{n+½}|²)``
+(with this definition the kinetic change equals the work of the step's forces on
+``dt (v_{n-½} + v_{n+½}) / 2`` exactly); gravity work ``m g . (x_n - x_0)``; load, damping and
+boundary (reaction) work accumulated with that same displacement. The run is declared failed at the
+first step where a value is non-finite or the energy balance residual exceeds ``blowup_tol`` times
+the largest energy scale seen (the signature of an unstable time step).
+"""
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxform._pytree import pytree_dataclass
+from jaxform.model import Energies, Hold, Model, State
+from jaxform.shell import Shell, forces_and_energy, stable_time_step
+
+
+class SimulationError(RuntimeError):
+    """A run failed; ``frames`` holds the frames up to the last good one, ``step``/``time`` where."""
+
+    def __init__(self, message, *, step, time, cause, frames, state):
+        super().__init__(message)
+        self.step = step
+        self.time = time
+        self.cause = cause
+        self.frames = frames
+        self.state = state
+
+
+@pytree_dataclass
+class Frames:
+    """Saved frames (leading axis: frame).
+
+    Attributes:
+        x: (F, N, 3) positions, m.
+        v: (F, N, 3) velocities (half step before the frame), m/s.
+        t: (F,) times, s.
+        step: (F,) step numbers.
+        energies: :class:`~jaxform.model.Energies` with (F,) arrays, J.
+        extras: tuple (one per load) of dicts of per-frame arrays.
+        ok: (F,) bool, the frame was reached before any failure.
+    """
+
+    x: Any
+    v: Any
+    t: Any
+    step: Any
+    energies: Any
+    extras: tuple
+    ok: Any
+
+
+def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, mass_scale: float = 1.0,
+               damping: float = 0.0, gravity=(0.0, 0.0, 0.0), fixed=None, drive=None, loads: tuple = (),
+               dtype=None) -> Model:
+    """Build a :class:`Model` on the host.
+
+    ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.shell.stable_time_step`);
+    a user ``dt`` above the limit is kept but warned about. ``mass_scale`` multiplies all masses
+    (raising the stable step by its square root). ``fixed`` (N, 3) bool marks driven dofs
+    (default none), ``drive`` gives their positions (default: held where they are).
+    """
+    dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0)
+    if dt is None:
+        dt = safety * dt_limit
+    elif dt > dt_limit:
+        warnings.warn(
+            f"time step {dt:.3e} s is above the estimated stable limit {dt_limit:.3e} s "
+            "(membrane and bending wave speeds on the smallest element); the run may blow up. "
+            "Use a smaller dt, mass scaling, or a coarser mesh.",
+            RuntimeWarning,
+            stacklevel=2,
+        )
+    n = shell.mesh.n_nodes
+    dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
+    x0 = jnp.asarray(shell.mesh.nodes, dtype)
+    fixed = jnp.zeros((n, 3), bool) if fixed is None else jnp.asarray(fixed, bool)
+    if fixed.shape != (n, 3):
+        raise ValueError(f"make_model: fixed has shape {fixed.shape}: need ({n}, 3) booleans (driven dofs)")
+    drive = Hold(x0) if drive is None else drive
+    mass = jnp.asarray(shell.node_masses(mass_scale), dtype)
+    return Model(shell=shell, mass=mass, fixed=fixed, drive=drive, gravity=jnp.asarray(gravity, dtype),
+                 damping=jnp.asarray(damping, dtype), dt=jnp.asarray(dt, dtype), loads=tuple(loads),
+                 mass_scale=mass_scale)
+
+
+def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -> State:
+    """The state at t = 0: positions ``x`` (default: the reference), velocities ``v`` (default 0)."""
+    dtype = model.mass.dtype
+    x = jnp.asarray(model.shell.mesh.nodes if x is None else x, dtype)
+    v = jnp.zeros_like(x) if v is None else jnp.asarray(v, dtype)
+    f_int, parts = forces_and_energy(x, model.shell)
+    ke = 0.5 * jnp.sum(model.mass[:, None] * v * v)
+    z = jnp.zeros((), dtype)
+    e = Energies(ke, parts["tension"], parts["shear"], parts["bending"], z, z, z, z)
+    loads = tuple(None for _ in model.loads) if load_states is None else tuple(load_states)
+    return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
+                 f_prev=f_int, bad_step=jnp.asarray(-1, jnp.int32), bad_code=jnp.asarray(0, jnp.int32),
+                 scale_max=e.scale())
+
+
+def _step(model: Model, state: State, x_ref, blowup_tol):
+    dt = model.dt
+    m = model.mass[:, None]
+    x, v_old, t = state.x, state.v, state.t
+    f_int, parts = forces_and_energy(x, model.shell)
+    f_grav = m * model.gravity
+    f_damp = -model.damping * m * v_old
+    f_loads = jnp.zeros_like(x)
+    new_loads, extras = [], []
+    for load, ls in zip(model.loads, state.loads):
+        f, ls_new, ex = load.force(x, v_old, t, ls)
+        f_loads = f_loads + f
+        new_loads.append(ls_new)
+        extras.append(ex)
+    f_free = f_int + f_grav + f_damp + f_loads
+    v_free = v_old + dt * f_free / m
+    x_drive = model.drive.position(t + dt)
+    v_drive = (x_drive - x) / dt
+    v_new = jnp.where(model.fixed, v_drive, v_free)
+    x_new = x + dt * v_new
+    dx = 0.5 * dt * (v_old + v_new)
+    reaction = jnp.where(model.fixed, m * (v_new - v_old) / dt - f_free, 0.0)
+    e_old = state.energies
+    e = Energies(
+        kinetic=0.25 * jnp.sum(m * (v_old * v_old + v_new * v_new)),
+        tension=parts["tension"],
+        shear=parts["shear"],
+        bending=parts["bending"],
+        gravity_work=jnp.sum(f_grav * (x - x_ref)),
+        external_work=e_old.external_work + jnp.sum(f_loads * dx),
+        boundary_work=e_old.boundary_work + jnp.sum(reaction * dx),
+        damping_work=e_old.damping_work - jnp.sum(f_damp * dx),
+    )
+    return x_new, v_new, e, tuple(new_loads), tuple(extras)
+
+
+def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
+    """Advance one time step (pure). A failed run stays frozen at its last good state."""
+    x_ref = model.drive.position(0.0) if x_ref is None else x_ref
+    e0 = state.energies if e0 is None else e0
+    x_new, v_new, e, loads, _ = _step(model, state, x_ref, blowup_tol)
+    return _guard(model, state, x_new, v_new, e, loads, e0, blowup_tol)
+
+
+def _guard(model, state, x_new, v_new, e, loads, e0, blowup_tol):
+    finite = jnp.all(jnp.isfinite(x_new)) & jnp.all(jnp.isfinite(v_new)) & jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic)
+    scale = jnp.maximum(state.scale_max, e.scale())
+    tiny = 1e-30 if x_new.dtype == jnp.float64 else 1e-20
+    blown = jnp.abs(e.balance(e0)) > blowup_tol * scale + tiny
+    code = jnp.where(~finite, 1, jnp.where(blown, 2, 0)).astype(jnp.int32)
+    healthy = state.bad_step < 0
+    fail_now = healthy & (code > 0)
+    keep = ~healthy | fail_now
+    new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
+                f_prev=state.f_prev, bad_step=jnp.where(fail_now, state.step, state.bad_step),
+                bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max))
+    frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), state, new)
+    # bookkeeping fields always advance
+    return State(x=frozen.x, v=frozen.v, t=frozen.t, step=state.step + 1, energies=frozen.energies,
+                 loads=frozen.loads, f_prev=state.f_prev, bad_step=new.bad_step, bad_code=new.bad_code,
+                 scale_max=frozen.scale_max)
+
+
+def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint: bool = True,
+            blowup_tol: float = 0.5):
+    """Run ``n_frames * every`` steps; return ``(final_state, frames)`` (pure, jit-able, differentiable).
+
+    Each chunk of ``every`` steps is a ``lax.scan`` wrapped in ``jax.checkpoint`` (when
+    ``checkpoint``), so reverse mode stores one state per frame and recomputes inside chunks.
+    """
+    e0 = state.energies
+    x_ref = state.x
+
+    def one(s, _):
+        x_new, v_new, e, loads, extras = _step(model, s, x_ref, blowup_tol)
+        return _guard(model, s, x_new, v_new, e, loads, e0, blowup_tol), extras
+
+    def chunk(s):
+        s, extras = jax.lax.scan(one, s, None, length=every)
+        return s, jax.tree_util.tree_map(lambda a: a[-1], extras)
+
+    if checkpoint:
+        chunk = jax.checkpoint(chunk)
+
+    def outer(s, _):
+        s, extras = chunk(s)
+        frame = (s.x, s.v, s.t, s.step, s.energies, extras, s.bad_step < 0)
+        return s, frame
+
+    s, (x, v, t, stp, en, extras, ok) = jax.lax.scan(outer, state, None, length=n_frames)
+    return s, Frames(x=x, v=v, t=t, step=stp, energies=en, extras=extras, ok=ok)
+
+
+_CAUSES = {
+    1: "non-finite positions, velocities or energies",
+    2: "energy blow-up (the energy balance no longer holds)",
+}
+
+
+def check(state: State, frames: Frames, model: Model):
+    """Host: raise :class:`SimulationError` if the run failed (frames up to the last good one kept)."""
+    bad = int(state.bad_step)
+    if bad < 0:
+        return
+    code = int(state.bad_code)
+    dt = float(model.dt)
+    ok = np.asarray(frames.ok)
+    good = jax.tree_util.tree_map(lambda a: a[: int(ok.sum())], frames)
+    raise SimulationError(
+        f"simulation failed at step {bad} (t = {bad * dt:.6e} s): {_CAUSES.get(code, 'unknown')}. "
+        f"Likely cause: the time step {dt:.3e} s is too large for the mesh (stable estimate "
+        f"{stable_time_step(model.shell, model.mass_scale, safety=1.0):.3e} s), or a distorted/inverted "
+        "element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh. "
+        f"{int(ok.sum())} good frames are in .frames.",
+        step=bad, time=bad * dt, cause=_CAUSES.get(code), frames=good, state=state,
+    )
+
+
+def simulate(model: Model, state: State | None = None, *, n_frames: int, every: int, checkpoint: bool = True,
+             blowup_tol: float = 0.5):
+    """Host driver: jit + run + health check. Returns ``(final_state, frames)``."""
+    state = init_state(model) if state is None else state
+    fn = jax.jit(rollout, static_argnames=("n_frames", "every", "checkpoint", "blowup_tol"))
+    s, frames = fn(model, state, n_frames=n_frames, every=every, checkpoint=checkpoint, blowup_tol=blowup_tol)
+    check(s, frames, model)
+    return s, frames
+
+
+__all__ = ["make_model", "init_state", "step", "rollout", "simulate", "check", "Frames", "SimulationError"]

@@ -1,0 +1,135 @@
+"""The shell element: forces are the energy gradient, rigid motions are force free, signs and readings."""
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxform.materials import NCF_FCIM359, WOVEN_38616, LinearBending, PolynomialShear, VoceBending
+from jaxform.mesh import Mesh
+from jaxform.shell import (Shell, _shear_energy, energy, energy_parts, fibre_curvatures, forces, shear_angle,
+                           fibre_vectors, shear_resultant)
+
+
+def _curved_sheared_mesh():
+    """A cylindrical-ish, doubly curved patch meshed with a skewed (sheared) grid: stress-free reference."""
+    m = Mesh.rectangle(0.06, 0.04, 0.006)
+    X = np.asarray(m.nodes)
+    u, w = X[:, 0], X[:, 1]
+    nodes = np.stack([u + 0.3 * w, w, 2.0 * u**2 - 1.0 * w**2 + 0.5 * u * w], axis=1)
+    return Mesh.from_arrays(nodes, m.faces)
+
+
+def _random_rotation(seed):
+    q, _ = np.linalg.qr(np.random.default_rng(seed).normal(size=(3, 3)))
+    return q * np.sign(np.linalg.det(q))
+
+
+@pytest.mark.parametrize("fabric", [WOVEN_38616, NCF_FCIM359])
+def test_rigid_motion_of_curved_sheared_reference_is_force_free(fabric):
+    mesh = _curved_sheared_mesh()
+    shell = Shell.build(mesh, fabric)
+    x0 = jnp.asarray(mesh.nodes)
+    R = _random_rotation(1)
+    x = x0 @ R.T + jnp.array([0.3, -0.2, 0.7])
+    f = forces(x, shell)
+    # force scale: a 1% deformation of the same mesh
+    xd = x0 + 0.01 * jnp.asarray(np.random.default_rng(2).normal(size=x0.shape)) * 0.006
+    scale = float(jnp.max(jnp.abs(forces(xd, shell))))
+    assert scale > 0
+    assert float(jnp.max(jnp.abs(f))) <= 1e-9 * scale
+    assert abs(float(energy(x, shell))) <= 1e-9 * abs(float(energy(xd, shell)))
+
+
+def test_rigid_motion_of_deformed_state_rotates_forces():
+    mesh = _curved_sheared_mesh()
+    shell = Shell.build(mesh, NCF_FCIM359)
+    rng = np.random.default_rng(3)
+    x = jnp.asarray(mesh.nodes) + 0.0005 * jnp.asarray(rng.normal(size=mesh.nodes.shape))
+    f = forces(x, shell)
+    R = jnp.asarray(_random_rotation(4))
+    f2 = forces(x @ R.T + jnp.array([1.0, 2.0, 3.0]), shell)
+    assert float(jnp.max(jnp.abs(f2 - f @ R.T))) <= 1e-9 * float(jnp.max(jnp.abs(f)))
+    assert float(jnp.max(jnp.abs(jnp.sum(f, axis=0)))) <= 1e-9 * float(jnp.max(jnp.abs(f)))  # no net force
+
+
+@pytest.mark.parametrize("fabric", [WOVEN_38616, NCF_FCIM359])
+def test_assembled_forces_equal_minus_energy_gradient(fabric):
+    mesh = Mesh.rectangle(0.03, 0.02, 0.005)
+    shell = Shell.build(mesh, fabric)
+    rng = np.random.default_rng(0)
+    x = jnp.asarray(mesh.nodes) + 0.0008 * jnp.asarray(rng.normal(size=mesh.nodes.shape))
+    f = forces(x, shell)
+    g = jax.grad(energy)(x, shell)
+    np.testing.assert_allclose(np.asarray(f), -np.asarray(g), rtol=1e-9, atol=1e-9 * float(jnp.max(jnp.abs(g))))
+
+
+def test_horner_shear_energy_matches_the_law():
+    g = jnp.linspace(-1.0, 1.0, 41)
+    for law in (WOVEN_38616.shear, NCF_FCIM359.shear):
+        np.testing.assert_allclose(_shear_energy(law, g, "a14"), law.integral2(g), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(_shear_energy(law, g, "conjugate"), law.integral(g), rtol=1e-12, atol=1e-12)
+
+
+def test_shear_angle_sign_and_value_ncf_stitch_stretch_positive():
+    mesh = Mesh.rectangle(0.02, 0.02, 0.005)
+    shell = Shell.build(mesh, NCF_FCIM359)
+    X = jnp.asarray(mesh.nodes)
+    # stretch along x (the stitch), contract along y, keeping the ±45° fibres' length: positive shear
+    gam = 0.3
+    th = 0.5 * (np.pi / 2 - gam)  # half angle between fibres
+    F = jnp.diag(jnp.array([np.cos(th) / np.cos(np.pi / 4), np.sin(th) / np.sin(np.pi / 4), 1.0]))
+    x = X @ F.T
+    gamma = shear_angle(fibre_vectors(x, mesh, shell.ref), shell.ref)
+    np.testing.assert_allclose(gamma, gam, rtol=1e-12)
+    p = energy_parts(x, shell)
+    assert float(p["tension"]) < 1e-20
+    area = 0.02 * 0.02
+    np.testing.assert_allclose(p["shear"], area * NCF_FCIM359.shear.integral2(gam), rtol=1e-10)
+
+
+def test_curvature_sign_and_value_on_a_cylinder():
+    mesh = Mesh.rectangle(0.05, 0.03, 0.0025)
+    shell = Shell.build(mesh, WOVEN_38616)
+    X = np.asarray(mesh.nodes)
+    R = 0.2
+    # drooping (bent down about the y axis, n = +z initially): positive curvature 1/R of the x fibre
+    phi = X[:, 0] / R
+    x = np.stack([R * np.sin(phi), X[:, 1], R * (np.cos(phi) - 1.0)], axis=1)
+    k = np.asarray(fibre_curvatures(jnp.asarray(x), mesh, shell.ref))
+    np.testing.assert_allclose(k[:, 0], 1.0 / R, rtol=2e-3)
+    np.testing.assert_allclose(k[:, 1], 0.0, atol=1e-9)
+    k_up = np.asarray(fibre_curvatures(jnp.asarray(x * np.array([1, 1, -1])), mesh, shell.ref))
+    np.testing.assert_allclose(k_up[:, 0], -1.0 / R, rtol=2e-3)
+
+
+def test_ncf_asymmetric_bending_energy_uses_pos_and_neg_sides():
+    mesh = Mesh.rectangle(0.05, 0.03, 0.0025)
+    shell = Shell.build(mesh, NCF_FCIM359)
+    X = np.asarray(mesh.nodes)
+    R = 0.5
+    s = (X[:, 0] + X[:, 1]) / np.sqrt(2)  # along the +45° fibre
+    for sign, law in ((1, NCF_FCIM359.bending[0].pos), (-1, NCF_FCIM359.bending[0].neg)):
+        dz = sign * -(R - np.sqrt(R**2 - s**2))
+        x = jnp.asarray(np.stack([X[:, 0], X[:, 1], dz], axis=1))
+        k = fibre_curvatures(x, mesh, shell.ref)
+        assert np.all(np.sign(np.asarray(k[:, 0])) == sign)
+
+
+def test_membrane_only_has_no_bending_energy():
+    from jaxform.materials import membrane_only
+
+    fab = membrane_only(WOVEN_38616)
+    mesh = Mesh.rectangle(0.03, 0.03, 0.005)
+    shell = Shell.build(mesh, fab)
+    X = np.asarray(mesh.nodes)
+    x = jnp.asarray(X + np.stack([0 * X[:, 0], 0 * X[:, 0], 0.001 * np.sin(100 * X[:, 0])], 1))
+    assert float(energy_parts(x, shell)["bending"]) == 0.0
+
+
+def test_shear_resultant_readings():
+    law = WOVEN_38616.shear
+    g = jnp.linspace(-0.9, 0.9, 19)
+    dW = jax.vmap(jax.grad(lambda a: _shear_energy(law, a, "a14")))(g)
+    np.testing.assert_allclose(shear_resultant(law, g, "a14"), dW, rtol=1e-10, atol=1e-12)
+    dWc = jax.vmap(jax.grad(lambda a: _shear_energy(law, a, "conjugate")))(g)
+    np.testing.assert_allclose(shear_resultant(law, g, "conjugate"), dWc, rtol=1e-10, atol=1e-12)

@@ -1,0 +1,396 @@
+"""Penalty contact with regularised Coulomb friction: fabric nodes against rigid tools and plies.
+
+Everything here is a pure function of arrays, written for one node and ``vmap``-ed; shapes are
+fixed (nodes out of contact get zero force through ``jnp.where``, never by filtering).
+
+Normal force (per node, on the fabric)
+    The ply's mid-surface nodes carry the contact: the gap is ``g = phi - offset`` where ``phi`` is
+    the tool's signed distance at the node and ``offset`` is half the ply thickness (for a ply in a
+    stack, the distance from its mid-surface to the face that touches that tool: also ``h / 2``
+    when each ply only touches the tools next to it). The penetration ``delta(g)`` is
+    ``max(-g, 0)``, or, with ``smooth_width = w > 0``, the C1 ramp ``g**2 / (2 w)`` for
+    ``-w < g < 0`` and ``-g - w/2`` beyond. The normal force is ``A * (k * delta + c * <-v_n>)``
+    along the tool normal (clamped >= 0: the damping never pulls), with ``A`` the node's
+    tributary area (m²), ``k`` the penalty stiffness **per unit area** (Pa/m: pressure per metre
+    of penetration) and ``c`` an optional damping (Pa·s/m). The contact pressure is therefore
+    ``k * delta`` (+ damping), independent of the mesh.
+
+Friction (regularised Coulomb)
+    ``F_t = -mu * F_n * v_t / sqrt(|v_t|**2 + eps_v**2)`` with ``v_t`` the tangential slip velocity
+    (node minus tool, or minus the other ply's point). It equals Coulomb's ``mu F_n`` once
+    ``|v_t| >> eps_v``, is continuous, and its derivative at zero slip is finite
+    (``-mu F_n / eps_v``). The price is creep: a node held by a tangential load ``F < mu F_n``
+    slides at ``v = eps_v r / sqrt(1 - r**2)``, ``r = F / (mu F_n)``. Choose ``eps_v`` small
+    against the process speed (``jaxform.cases`` uses 1% of the punch speed).
+
+Penalty stiffness (automatic)
+    A node of mass ``m = rho_A A`` on a contact spring ``k A`` oscillates at ``omega**2 = k /
+    rho_A``, independent of the mesh. :func:`auto_penalty_stiffness` takes ``k = s * rho_A /
+    dt**2`` (default ``s = 0.1``: ``omega dt = 0.32``, which takes about 1% off the stable step of
+    a shell already at 90% of its own) and reports the penetration ``p / k`` under an expected
+    pressure, which should stay small against the ply thickness.
+
+The blank holder under force control is a 1-DOF rigid body (:func:`holder_step`) advanced with
+the same central-difference (leapfrog) scheme as the fabric.
+"""
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import jax
+import jax.numpy as jnp
+
+from jaxform import tools, validate
+from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass
+from jaxform.tools import closest_point_triangle, safe_norm, safe_normalize
+
+
+@pytree_dataclass
+class ContactParams:
+    """Parameters of one contact interface (all leaves, so they can be differentiated).
+
+    Attributes:
+        stiffness: penalty stiffness per unit area ``k``, Pa/m.
+        friction: Coulomb coefficient ``mu`` (-); 0.23 tool–fabric, 0.36 fabric–fabric.
+        slip_velocity: regularisation velocity ``eps_v`` of the friction law, m/s.
+        damping: normal damping per unit area ``c``, Pa·s/m (0: none).
+        smooth_width: width ``w`` of the C1 penetration ramp, m (0: plain ``max(-g, 0)``).
+    """
+
+    stiffness: Any
+    friction: Any = 0.23
+    slip_velocity: Any = 1.0e-3
+    damping: Any = 0.0
+    smooth_width: Any = 0.0
+
+    def __post_init__(self):
+        vals = (self.stiffness, self.friction, self.slip_velocity, self.damping, self.smooth_width)
+        if is_concrete(*vals):
+            validate.positive("ContactParams", "stiffness", self.stiffness, "Pa/m")
+            validate.nonnegative("ContactParams", "friction", self.friction)
+            validate.positive("ContactParams", "slip_velocity", self.slip_velocity, "m/s")
+            validate.nonnegative("ContactParams", "damping", self.damping, "Pa·s/m")
+            validate.nonnegative("ContactParams", "smooth_width", self.smooth_width, "m")
+            for n in ("stiffness", "friction", "slip_velocity", "damping", "smooth_width"):
+                object.__setattr__(self, n, as_leaf(getattr(self, n)))
+
+
+@pytree_dataclass
+class ContactResult:
+    """Outcome of one contact evaluation.
+
+    Attributes:
+        force: (N, 3) force on each fabric node, N.
+        reaction: (3,) total force on the tool (minus the sum of ``force``), N; for ply–ply
+            contact, zero (the forces are internal to the stack).
+        pressure: (N,) normal contact pressure at each (slave) node, Pa.
+        gap: (N,) gap ``g`` (negative: penetration), m.
+        energy: () penalty energy stored, J (``damping`` and friction excluded).
+        friction_power: () power dissipated by friction, W (>= 0).
+    """
+
+    force: Any
+    reaction: Any
+    pressure: Any
+    gap: Any
+    energy: Any
+    friction_power: Any
+
+
+# ---------------------------------------------------------------------------------------------
+# One node
+# ---------------------------------------------------------------------------------------------
+
+
+def penetration(g, width):
+    """Penetration ``delta(g)``, m, and its energy density ``e = int_0^{-g} delta``, m², for gap g (m)."""
+    w = jnp.asarray(width)
+    ws = jnp.where(w > 0, w, 1.0)
+    p = -g
+    deep = p >= w
+    ramp = (p > 0) & ~deep
+    delta = jnp.where(deep, p - 0.5 * w, jnp.where(ramp, 0.5 * p * p / ws, 0.0))
+    energy = jnp.where(deep, w * w / 6.0 + 0.5 * (p * p - w * w) - 0.5 * w * (p - w),
+                       jnp.where(ramp, p**3 / (6.0 * ws), 0.0))
+    return delta, energy
+
+
+def regularised_friction(v_t, normal_force, mu, eps_v):
+    """Regularised Coulomb force (3,), N, for slip velocity ``v_t`` (3,) m/s and ``F_n`` >= 0 (N).
+
+    ``-mu F_n v_t / sqrt(|v_t|^2 + eps_v^2)``: magnitude below ``mu F_n``, smooth at zero slip.
+    """
+    return -mu * normal_force * v_t / jnp.sqrt(jnp.sum(v_t * v_t) + eps_v * eps_v)
+
+
+def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
+    """Contact force on one node against a rigid surface.
+
+    Args:
+        phi: () signed distance of the node to the tool, m.
+        normal: (3,) outward unit normal of the tool at the node.
+        v_rel: (3,) node velocity minus the tool's, m/s.
+        offset: () distance from the node (mid-surface) to the contacting face, m (``h / 2``).
+        area: () tributary area of the node, m².
+        params: :class:`ContactParams`.
+
+    Returns:
+        ``(force (3,) N, pressure () Pa, gap () m, energy () J, friction_power () W)``.
+    """
+    g = phi - offset
+    delta, e = penetration(g, params.smooth_width)
+    in_contact = delta > 0
+    v_n = jnp.dot(v_rel, normal)
+    p_elastic = params.stiffness * delta
+    p_damp = jnp.where(in_contact, -params.damping * v_n, 0.0)
+    pressure = jnp.maximum(p_elastic + p_damp, 0.0)
+    f_n = pressure * area
+    v_t = v_rel - v_n * normal
+    f_t = regularised_friction(v_t, f_n, params.friction, params.slip_velocity)
+    force = f_n * normal + f_t
+    return force, pressure, g, area * params.stiffness * e, -jnp.dot(f_t, v_t)
+
+
+def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_velocity, active=None) -> ContactResult:
+    """Contact of all fabric nodes with one rigid tool.
+
+    Args:
+        tool: a tool pytree (:mod:`jaxform.tools`).
+        x: (N, 3) node positions, m; v: (N, 3) node velocities, m/s.
+        offset: () or (N,) mid-surface-to-face distance, m (``h / 2`` for a single ply).
+        area: () or (N,) tributary area per node, m².
+        params: :class:`ContactParams`.
+        dz: () vertical displacement of the tool, m (:func:`jaxform.tools.displacement`, or the
+            holder state in force mode).
+        tool_velocity: (3,) tool velocity, m/s.
+        active: optional (N,) 0/1 weights: which nodes may touch this tool (e.g. only the ply
+            next to it in a stack).
+
+    Returns:
+        :class:`ContactResult`.
+    """
+    x = jnp.asarray(x)
+    n = x.shape[0]
+    phi, normal = tools.sdf(tool, x, dz)
+    offset = jnp.broadcast_to(jnp.asarray(offset, x.dtype), (n,))
+    area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (n,))
+    v_rel = jnp.asarray(v) - jnp.asarray(tool_velocity, x.dtype)
+    f, p, g, e, pw = jax.vmap(node_contact, in_axes=(0, 0, 0, 0, 0, None))(phi, normal, v_rel, offset, area, params)
+    if active is not None:
+        a = jnp.asarray(active, x.dtype)
+        f, p, e, pw = f * a[:, None], p * a, e * a, pw * a
+    return ContactResult(force=f, reaction=-jnp.sum(f, axis=0), pressure=p, gap=g, energy=jnp.sum(e),
+                         friction_power=jnp.sum(pw))
+
+
+def tool_pose(tool, t):
+    """``(dz, velocity (3,))`` of a tool under its prescribed motion at time ``t``."""
+    return tools.displacement(tool, t), tools.velocity(tool, t)
+
+
+# ---------------------------------------------------------------------------------------------
+# Ply–ply contact (node to surface)
+# ---------------------------------------------------------------------------------------------
+
+
+def quads_to_triangles(faces):
+    """(F, 4) quads -> (2F, 3) triangles (split along the 0–2 diagonal); triangles pass through."""
+    faces = jnp.asarray(faces)
+    if faces.shape[1] == 3:
+        return faces
+    return jnp.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]], axis=0)
+
+
+def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
+    """Candidate table for ply–ply contact: the ``k`` triangles with the nearest centroids.
+
+    Cost ``O(N_s F)`` (``chunk`` slave nodes at a time): refresh it every so many steps, not
+    every step (plies slide by less than an element between refreshes).
+
+    Args:
+        x: (N, 3) all node positions, m.
+        slave: (N_s,) int indices of the slave nodes (the ply on top).
+        triangles: (F, 3) int node indices of the master ply's triangles.
+        k: candidates per slave node (static).
+
+    Returns:
+        (N_s, k) int32 triangle indices.
+    """
+    x = jnp.asarray(x)
+    tri = jnp.asarray(triangles)
+    cen = jnp.mean(x[tri], axis=1)
+    ps = x[jnp.asarray(slave)]
+    ns = ps.shape[0]
+    chunk = int(max(1, min(chunk, ns)))
+    pad = (-ns) % chunk
+    ps = jnp.concatenate([ps, jnp.zeros((pad, 3), ps.dtype)]).reshape(-1, chunk, 3)
+    k = int(min(k, tri.shape[0]))
+
+    def block(p):
+        d2 = jnp.sum((p[:, None, :] - cen[None, :, :]) ** 2, axis=-1)
+        return jax.lax.top_k(-d2, k)[1].astype(jnp.int32)
+
+    return jax.lax.map(block, ps).reshape(-1, k)[:ns]
+
+
+def _ply_node(p, vp, tri_x, tri_v, gap0, area, params):
+    """One slave node against its K candidate triangles ((K, 3, 3) positions and velocities)."""
+    q, w = jax.vmap(closest_point_triangle, in_axes=(None, 0, 0, 0))(p, tri_x[:, 0], tri_x[:, 1], tri_x[:, 2])
+    d2 = jnp.sum((p - q) ** 2, axis=-1)
+    j = jnp.argmin(d2)
+    a, b, c = tri_x[j]
+    n = safe_normalize(jnp.cross(b - a, c - a))
+    d = p - q[j]
+    signed = jnp.where(jnp.dot(d, n) >= 0, 1.0, -1.0) * safe_norm(d)
+    v_master = w[j] @ tri_v[j]
+    force, pressure, g, e, pw = node_contact(signed, n, vp - v_master, gap0, area, params)
+    return force, w[j], j, pressure, g, e, pw
+
+
+def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactParams) -> ContactResult:
+    """Node-to-surface contact between two plies of a stack, with friction.
+
+    Each slave node (of the upper ply) is tested against its candidate triangles of the master
+    (lower) ply; the gap is the signed distance to the closest point, measured along the master
+    triangle's normal side (the side of ``(b - a) x (c - a)``: orient the master's faces towards
+    the slave ply), minus ``gap0`` (mid-surface to mid-surface distance of touching plies, ``(h_1
+    + h_2) / 2``). The force on a slave node is applied, with the opposite sign, to the three
+    nodes of the master triangle with the barycentric weights of the closest point, so momentum
+    is conserved. A node beyond the master ply's edge sees a lateral distance, hence no contact.
+
+    Args:
+        x, v: (N, 3) all node positions (m) and velocities (m/s).
+        slave: (N_s,) int slave node indices.
+        triangles: (F, 3) int master triangles (:func:`quads_to_triangles` for quad meshes).
+        candidates: (N_s, K) int candidate triangles per slave (:func:`nearest_faces`).
+        gap0: () contact distance between mid-surfaces, m.
+        area: () or (N_s,) tributary area of each slave node, m².
+        params: :class:`ContactParams` (``friction`` 0.36 fabric–fabric).
+
+    Returns:
+        :class:`ContactResult` with ``force`` (N, 3) on all nodes, ``pressure``/``gap`` (N_s,).
+    """
+    x, v = jnp.asarray(x), jnp.asarray(v)
+    slave = jnp.asarray(slave)
+    tri = jnp.asarray(triangles)
+    cand = jnp.asarray(candidates)
+    ns = slave.shape[0]
+    area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (ns,))
+    tri_c = tri[cand]  # (N_s, K, 3) node indices
+    f, w, j, p, g, e, pw = jax.vmap(_ply_node, in_axes=(0, 0, 0, 0, None, 0, None))(
+        x[slave], v[slave], x[tri_c], v[tri_c], jnp.asarray(gap0, x.dtype), area, params
+    )
+    master_nodes = jnp.take_along_axis(tri_c, j[:, None, None], axis=1)[:, 0, :]  # (N_s, 3)
+    force = jnp.zeros_like(x).at[slave].add(f)
+    force = force.at[master_nodes.reshape(-1)].add((-w[:, :, None] * f[:, None, :]).reshape(-1, 3))
+    return ContactResult(force=force, reaction=jnp.zeros(3, x.dtype), pressure=p, gap=g, energy=jnp.sum(e),
+                         friction_power=jnp.sum(pw))
+
+
+# ---------------------------------------------------------------------------------------------
+# Automatic penalty stiffness
+# ---------------------------------------------------------------------------------------------
+
+
+def auto_penalty_stiffness(areal_mass, dt, *, safety: float = 0.1):
+    """Penalty stiffness per unit area, Pa/m, that keeps the contact stable in an explicit step.
+
+    ``k = safety * areal_mass / dt**2``: the contact frequency of a node is ``sqrt(k / rho_A)``
+    whatever its area, so ``omega_c dt = sqrt(safety)``.
+
+    Args:
+        areal_mass: mass per unit area the integrator uses (after mass scaling; for a node shared
+            by a stack, the smallest ply's), kg/m².
+        dt: time step, s.
+        safety: ``(omega_c dt)**2``, default 0.1.
+    """
+    if is_concrete(areal_mass, dt, safety):
+        validate.positive("auto_penalty_stiffness", "areal_mass", areal_mass, "kg/m²")
+        validate.positive("auto_penalty_stiffness", "dt", dt, "s")
+        validate.in_range("auto_penalty_stiffness", "safety", safety, 0.0, 1.0)
+    return safety * areal_mass / dt**2
+
+
+def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_velocity: float = 1.0e-3,
+                   stiffness=None, damping_ratio: float = 0.1, expected_pressure: float = 1.0e5,
+                   max_penetration: float = 0.1, safety: float = 0.1) -> ContactParams:
+    """:class:`ContactParams` with the penalty stiffness chosen automatically (or ``stiffness``).
+
+    Also checks, at the edge, that the penetration under ``expected_pressure`` (Pa; 1e5 Pa is well
+    above the holder pressure of the paper's 1000 N case) stays below ``max_penetration`` times
+    the ply ``thickness``; otherwise the step is too large for a stiff enough contact and a
+    ``ValueError`` says so. ``damping_ratio`` sets ``c = 2 zeta sqrt(k rho_A)``.
+    """
+    k = auto_penalty_stiffness(areal_mass, dt, safety=safety) if stiffness is None else stiffness
+    if is_concrete(k, thickness, expected_pressure):
+        validate.positive("contact_params", "stiffness", k, "Pa/m")
+        pen = float(expected_pressure) / float(k)
+        if pen > max_penetration * float(thickness):
+            raise ValueError(
+                f"contact_params: stiffness = {float(k):.3g} Pa/m gives a penetration of {pen * 1e3:.3g} mm "
+                f"under {float(expected_pressure):.3g} Pa, more than {max_penetration:g} x the ply thickness "
+                f"({float(thickness) * 1e3:.3g} mm); use a smaller time step (less mass scaling) or give "
+                "a larger stiffness with a smaller step"
+            )
+    c = 2.0 * damping_ratio * jnp.sqrt(k * areal_mass) if damping_ratio else 0.0
+    return ContactParams(stiffness=k, friction=friction, slip_velocity=slip_velocity,
+                         damping=float(c) if is_concrete(c) else c)
+
+
+# ---------------------------------------------------------------------------------------------
+# Force-controlled blank holder
+# ---------------------------------------------------------------------------------------------
+
+
+@pytree_dataclass
+class HolderState:
+    """State of a force-controlled blank holder (1 DOF, vertical).
+
+    Attributes:
+        dz: () vertical displacement from its reference pose, m.
+        vz: () vertical velocity at the last half step, m/s (leapfrog).
+    """
+
+    dz: Any = 0.0
+    vz: Any = 0.0
+
+
+def holder_step(state: HolderState, reaction_z, *, mass, force, dt, damping=0.0) -> HolderState:
+    """Advance the blank holder one central-difference step.
+
+    ``m a = -force + R_z - c v``, ``v_{n+1/2} = v_{n-1/2} + dt a_n``, ``z_{n+1} = z_n + dt
+    v_{n+1/2}`` — the same leapfrog as the fabric.
+
+    Args:
+        state: :class:`HolderState` at step n.
+        reaction_z: () vertical force of the fabric on the holder at step n, N (the ``reaction[2]``
+            of :func:`tool_contact` for the holder).
+        mass: () holder mass, kg (a numerical parameter: any mass with
+            ``sqrt(k_contact / mass) dt < 2`` is stable).
+        force: () prescribed clamping force pushing the holder down, N (1000 N for Case B),
+            including the holder's weight.
+        dt: () time step, s.
+        damping: () viscous damping of the holder, N·s/m.
+    """
+    a = (-force + reaction_z - damping * state.vz) / mass
+    vz = state.vz + dt * a
+    return HolderState(dz=state.dz + dt * vz, vz=vz)
+
+
+__all__ = [
+    "ContactParams",
+    "ContactResult",
+    "HolderState",
+    "penetration",
+    "regularised_friction",
+    "node_contact",
+    "tool_contact",
+    "tool_pose",
+    "ply_contact",
+    "nearest_faces",
+    "quads_to_triangles",
+    "auto_penalty_stiffness",
+    "contact_params",
+    "holder_step",
+]

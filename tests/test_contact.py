@@ -1,0 +1,236 @@
+"""Contact kernel: penalty equilibrium, regularised friction, ply-ply contact, holder dynamics."""
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxform import contact, tools
+
+H = 0.3e-3  # ply thickness, m
+RHO_A = 0.21  # kg/m²
+
+
+_tool_contact = jax.jit(contact.tool_contact)
+_ply_contact = jax.jit(contact.ply_contact)
+
+
+def _params(**kw):
+    base = dict(stiffness=4.0e10, friction=0.23, slip_velocity=1e-3)
+    base.update(kw)
+    return contact.ContactParams(**base)
+
+
+def test_penalty_equilibrium_returns_the_applied_pressure():
+    """Nodes on a flat plate pushed by a known pressure: at the penalty equilibrium the contact
+    pressure is that pressure and the reaction on the plate is the total load."""
+    plate = tools.Plane(point=[0.0, 0.0, 0.0])
+    params = _params()
+    area = np.array([1e-6, 4e-6, 2.5e-6])
+    p_applied = 1.234e4
+    # Equilibrium: k * delta = p  ->  node z = h/2 - p/k.
+    z = H / 2 - p_applied / params.stiffness
+    x = np.column_stack([np.zeros(3), np.arange(3) * 1e-3, np.full(3, z)])
+    res = _tool_contact(plate, x, np.zeros((3, 3)), H / 2, area, params, dz=0.0, tool_velocity=np.zeros(3))
+    np.testing.assert_allclose(res.pressure, p_applied, rtol=1e-10)
+    np.testing.assert_allclose(res.force[:, 2], p_applied * area, rtol=1e-10)
+    np.testing.assert_allclose(res.reaction, [0, 0, -p_applied * area.sum()], rtol=1e-10)
+    np.testing.assert_allclose(res.gap, -p_applied / params.stiffness, rtol=1e-10)
+    # Out of contact: nothing.
+    res = _tool_contact(plate, x + [0, 0, 1e-3], np.zeros((3, 3)), H / 2, area, params, dz=0.0,
+                               tool_velocity=np.zeros(3))
+    assert float(jnp.abs(res.force).max()) == 0.0
+
+
+@pytest.mark.parametrize("width", [0.0, 2e-5])
+def test_normal_force_is_minus_gradient_of_penalty_energy(width):
+    punch = tools.Punch(0.05)
+    params = _params(friction=0.0, smooth_width=width)
+    rng = np.random.default_rng(0)
+    # Nodes just inside the punch surface (penetrations 0..40 micrometre) and some outside.
+    dirs = rng.normal(size=(30, 3))
+    dirs[:, 2] = -np.abs(dirs[:, 2])
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    x = np.array([0, 0, 0.05]) + dirs * (0.05 + H / 2 + rng.uniform(-4e-5, 2e-5, (30, 1)))
+    area = 1e-6
+
+    def energy(xx):
+        return contact.tool_contact(punch, xx, jnp.zeros_like(xx), H / 2, area, params, dz=0.0,
+                                    tool_velocity=jnp.zeros(3)).energy
+
+    res = _tool_contact(punch, x, np.zeros_like(x), H / 2, area, params, dz=0.0, tool_velocity=np.zeros(3))
+    np.testing.assert_allclose(res.force, -jax.grad(energy)(jnp.asarray(x)), rtol=1e-8, atol=1e-12)
+
+
+def test_smooth_penetration_is_c1_and_matches_plain_beyond_width():
+    w = 1e-5
+    g = jnp.linspace(-5e-5, 1e-5, 61)
+    d_s, _ = contact.penetration(g, w)
+    d_p, _ = contact.penetration(g, 0.0)
+    deep = g <= -w
+    np.testing.assert_allclose(np.asarray(d_s)[deep], np.asarray(d_p - w / 2)[deep], rtol=1e-12, atol=1e-20)
+    slope = jax.vmap(jax.grad(lambda gg: contact.penetration(gg, w)[0]))
+    np.testing.assert_allclose(slope(jnp.array([-w - 1e-12, -w + 1e-12])), [-1.0, -1.0], atol=1e-6)
+    np.testing.assert_allclose(slope(jnp.array([0.0, 1e-6])), [0.0, 0.0], atol=1e-12)
+
+
+def test_friction_saturates_at_mu_n_and_is_smooth_at_zero_slip():
+    mu, eps, fn = 0.23, 1e-3, 2.0
+    f = lambda vt: contact.regularised_friction(vt, fn, mu, eps)
+    big = f(jnp.array([1.0, 0.0, 0.0]))
+    np.testing.assert_allclose(big, [-mu * fn * 1.0 / math.sqrt(1 + eps**2), 0, 0], rtol=1e-12)
+    assert abs(float(big[0]) + mu * fn) < 1e-6 * mu * fn  # Coulomb within 1e-6 at 1000 eps
+    speeds = jnp.logspace(-8, 1, 50)
+    mags = jax.vmap(lambda s: safe(f(jnp.array([s, 0.0, 0.0]))))(speeds)
+    assert np.all(np.asarray(mags) <= mu * fn) and np.all(np.diff(np.asarray(mags)) > 0)
+    # Continuous through zero slip, finite derivative there: -mu F_n / eps.
+    np.testing.assert_allclose(f(jnp.zeros(3)), 0.0)
+    jac = jax.jacfwd(f)(jnp.zeros(3))
+    np.testing.assert_allclose(jac, -mu * fn / eps * np.eye(3), rtol=1e-12)
+    # Through the whole kernel: finite gradient w.r.t. node velocity and position at zero slip.
+    plate = tools.Plane(point=[0.0, 0.0, 0.0])
+    params = _params()
+    x = jnp.array([[0.0, 0.0, H / 2 - 1e-6]])
+
+    def ft(xx, vv):
+        r = contact.tool_contact(plate, xx, vv, H / 2, 1e-6, params, dz=0.0, tool_velocity=jnp.zeros(3))
+        return r.force[0, 0]
+
+    gx, gv = jax.grad(ft, argnums=(0, 1))(x, jnp.zeros((1, 3)))
+    assert np.all(np.isfinite(gx)) and np.all(np.isfinite(gv))
+    np.testing.assert_allclose(gv[0, 0], -params.friction * params.stiffness * 1e-6 * 1e-6 / params.slip_velocity)
+
+
+def safe(v):
+    return jnp.sqrt(jnp.sum(v * v))
+
+
+def test_friction_opposes_slip_relative_to_moving_tool_and_dissipates():
+    plate = tools.Plane(point=[0.0, 0.0, 0.0])
+    params = _params(friction=0.3)
+    x = np.array([[0.0, 0.0, H / 2 - 1e-6]])
+    v = np.array([[0.2, 0.0, 0.0]])
+    res = _tool_contact(plate, x, v, H / 2, 1e-6, params, dz=0.0, tool_velocity=np.array([0.5, 0.0, 0.0]))
+    fn = float(res.force[0, 2])
+    np.testing.assert_allclose(fn, params.stiffness * 1e-6 * 1e-6, rtol=1e-12)
+    assert float(res.force[0, 0]) > 0  # node slower than the tool: dragged along +x
+    np.testing.assert_allclose(float(res.force[0, 0]), 0.3 * fn, rtol=1e-5)
+    assert float(res.friction_power) > 0
+    np.testing.assert_allclose(res.reaction, -res.force[0])
+
+
+def test_node_on_tilted_plate_starts_sliding_at_the_friction_angle():
+    """One contact node of a ply under gravity on a plate tilted by theta: below atan(mu) it only
+    creeps at the regularisation speed; 1 degree above it accelerates."""
+    mu, eps, g = 0.36, 1e-4, 9.81
+    area, dt = 1e-6, 1e-5
+    m = RHO_A * area
+    k = contact.auto_penalty_stiffness(RHO_A, dt)
+    params = contact.ContactParams(stiffness=k, friction=mu, slip_velocity=eps,
+                                   damping=2 * 0.5 * math.sqrt(k * RHO_A))
+
+    def final_speed(theta):
+        n = jnp.array([0.0, math.sin(theta), math.cos(theta)])
+        plate = tools.Plane(point=[0.0, 0.0, 0.0], normal=n)
+        x0 = (H / 2 - RHO_A * g / k) * n
+
+        def step(carry, _):
+            x, v = carry
+            r = contact.tool_contact(plate, x[None], v[None], H / 2, area, params, dz=0.0, tool_velocity=jnp.zeros(3))
+            a = r.force[0] / m + jnp.array([0.0, 0.0, -g])
+            v = v + dt * a
+            return (x + dt * v, v), None
+
+        (x, v), _ = jax.lax.scan(step, (jnp.asarray(x0), jnp.zeros(3)), None, length=4000)
+        return float(jnp.linalg.norm(v))
+
+    crit = math.atan(mu)
+    below, above = final_speed(crit - math.radians(1.0)), final_speed(crit + math.radians(1.0))
+    r = math.tan(crit - math.radians(1.0)) / mu
+    assert below < 1.5 * eps * r / math.sqrt(1 - r * r)  # creep only
+    # Above: accelerating at about g (sin - mu cos) after 0.04 s.
+    a_ref = g * (math.sin(crit + math.radians(1.0)) - mu * math.cos(crit + math.radians(1.0)))
+    assert above > 0.5 * a_ref * 0.04 and above > 20 * eps
+
+
+def test_auto_penalty_stiffness_is_stable_and_stiff():
+    dt = 1e-6
+    k = contact.auto_penalty_stiffness(RHO_A, dt)
+    np.testing.assert_allclose(k, 0.1 * RHO_A / dt**2)
+    np.testing.assert_allclose(math.sqrt(k / RHO_A) * dt, math.sqrt(0.1))
+    # Penetration under 18.5 kPa (1000 N on the holder ring) is far below h.
+    assert 1.85e4 / k < 1e-2 * H
+    # A node bouncing on the contact spring with leapfrog stays bounded at this k, blows up at 50x.
+    def peak(stiff, steps=2000):
+        z, v = -1e-7, 0.0
+        for _ in range(steps):
+            v += dt * (-stiff * z) / RHO_A
+            z += dt * v
+        return abs(z)
+    with np.errstate(over="ignore", invalid="ignore"):
+        assert peak(k) < 2e-7 and not peak(50 * k) < 1e-3
+    p = contact.contact_params(RHO_A, dt, H, friction=0.23)
+    assert float(p.stiffness) == pytest.approx(k) and float(p.damping) > 0
+    assert float(contact.contact_params(RHO_A, dt, H, stiffness=1e12).stiffness) == 1e12
+    with pytest.raises(ValueError, match="penetration"):
+        contact.contact_params(RHO_A, 1e-3, H)
+    with pytest.raises(ValueError, match="dt"):
+        contact.auto_penalty_stiffness(RHO_A, 0.0)
+
+
+def test_holder_step_under_constant_force():
+    mass, force, dt = 2.0, 1000.0, 1e-4
+    s = contact.HolderState()
+    n = 100
+    for _ in range(n):
+        s = contact.holder_step(s, 0.0, mass=mass, force=force, dt=dt)
+    a = -force / mass
+    np.testing.assert_allclose(s.vz, a * dt * n, rtol=1e-12)
+    np.testing.assert_allclose(s.dz, a * dt**2 * n * (n + 1) / 2, rtol=1e-12)
+    # Resting on a linear "fabric" spring: settles where the reaction balances the force.
+    K = 1e7
+    s = contact.HolderState()
+    step = jax.jit(lambda st: contact.holder_step(st, -K * st.dz, mass=mass, force=force, dt=dt,
+                                                   damping=2 * math.sqrt(K * mass)))
+    for _ in range(3000):
+        s = step(s)
+    np.testing.assert_allclose(s.dz, -force / K, rtol=1e-6)
+
+
+def _flat_ply(nx, ny, spacing, z, offset=(0.0, 0.0)):
+    xs, ys = np.meshgrid(np.arange(nx) * spacing + offset[0], np.arange(ny) * spacing + offset[1], indexing="ij")
+    nodes = np.column_stack([xs.ravel(), ys.ravel(), np.full(nx * ny, z)])
+    idx = np.arange(nx * ny).reshape(nx, ny)
+    quads = np.column_stack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()])
+    return nodes, quads
+
+
+def test_ply_ply_contact_pressure_friction_and_momentum():
+    h, s = H, 2e-3
+    lower, quads = _flat_ply(5, 5, s, 0.0)
+    delta = 2e-6
+    upper, _ = _flat_ply(3, 3, s, h - delta, offset=(s * 0.7, s * 0.6))  # shifted: not node-matched
+    x = np.vstack([lower, upper])
+    slave = np.arange(25, 34)
+    tri = contact.quads_to_triangles(quads)
+    cand = jax.jit(contact.nearest_faces, static_argnames=("k",))(x, slave, tri, k=8)
+    v = np.zeros_like(x)
+    v[slave, 0] = 0.05  # upper ply sliding along +x
+    params = _params(friction=0.36)
+    res = _ply_contact(x, v, slave, tri, cand, h, s * s, params)
+    fn = params.stiffness * delta * s * s
+    np.testing.assert_allclose(res.pressure, params.stiffness * delta, rtol=1e-9)
+    np.testing.assert_allclose(res.force[slave, 2], fn, rtol=1e-9)
+    np.testing.assert_allclose(res.force[slave, 0], -0.36 * fn * 0.05 / math.hypot(0.05, 1e-3), rtol=1e-9)
+    np.testing.assert_allclose(res.force.sum(axis=0), 0.0, atol=1e-12 * fn)  # internal forces
+    # Lower ply receives the opposite load.
+    np.testing.assert_allclose(res.force[:25, 2].sum(), -9 * fn, rtol=1e-9)
+    # A slave node beyond the edge of the master ply does not touch it.
+    x_far = x.copy()
+    x_far[25, :2] = [-0.02, -0.02]
+    res = _ply_contact(x_far, v, slave, tri, cand, h, s * s, params)
+    assert float(res.pressure[0]) == 0.0
+    # Finite gradients.
+    gx = jax.jit(jax.grad(lambda xx: contact.ply_contact(xx, v, slave, tri, cand, h, s * s, params).energy))(jnp.asarray(x))
+    assert np.all(np.isfinite(gx))

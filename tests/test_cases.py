@@ -1,0 +1,131 @@
+"""Forming case descriptions: presets, strict validation naming the key, overrides, TOML round trip."""
+import copy
+import math
+
+import pytest
+
+from jaxform import cases, materials, tools
+
+SPEC_NAMES = [f"case-a-{f}-{b}" for f in ("woven", "ncf") for b in ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")]
+SPEC_NAMES += ["case-b-woven-nlbm", "case-b-ncf-nlbm"]
+
+
+def test_presets_are_the_spec_names_and_load():
+    assert [n for n, _ in cases.list_presets()] == SPEC_NAMES
+    for name in SPEC_NAMES:
+        case = cases.load(name)
+        assert case.name == name
+        fab = cases.build_fabric(case)
+        assert isinstance(fab, materials.Fabric)
+        assert fab.membrane_only == name.endswith("membrane")
+        assert cases.loads(cases.to_toml(case)) == case  # TOML round trip
+
+
+def test_case_a_and_b_match_the_paper():
+    a = cases.load("case-a-woven-nlbm")
+    assert a.n_plies == 1 and a.holder.mode == "gap"
+    assert a.holder.gap == pytest.approx(7e-3) and a.element_size == pytest.approx(2e-3)
+    assert a.process.stroke == pytest.approx(0.05) and a.blank_size == pytest.approx(0.25)
+    assert a.tools.punch_radius == pytest.approx(0.05) and a.tools.die_opening_radius == pytest.approx(0.053)
+    assert a.tools.die_fillet == pytest.approx(0.006)
+    b = cases.load("case-b-ncf-nlbm")
+    assert b.n_plies == 2 and b.orientations == (0.0, 0.0)
+    assert b.holder.mode == "force" and b.holder.force == 1000.0 and b.element_size == pytest.approx(1e-3)
+    assert cases.build_fabric(cases.load("case-a-woven-lbm-41")).bending[0].b == pytest.approx(2.2e-4)
+    assert cases.build_fabric(cases.load("case-a-ncf-lbm-inf")).name.endswith("lbm-inf")
+
+
+def test_build_tools_places_the_rig():
+    case = cases.load("case-b-woven-nlbm")
+    rig = cases.build_tools(case)
+    h = case.ply_thickness
+    assert isinstance(rig.punch, tools.Punch)
+    assert float(rig.punch.apex_z) == pytest.approx(2 * h)
+    assert float(rig.holder.bottom_z) == pytest.approx(2 * h)
+    assert cases.ply_heights(case) == pytest.approx([1.5 * h, 0.5 * h])
+    assert float(rig.punch.motion.displacement(1e3)) == pytest.approx(-0.05)
+    assert cases.stroke_time(case) == pytest.approx(0.05 / 0.5 + 0.5 * 0.1 * 0.1)
+    a = cases.build_tools(cases.load("case-a-woven-nlbm"))
+    assert float(a.holder.bottom_z) == pytest.approx(7e-3)
+
+
+def _bad(change, key_fragment):
+    d = copy.deepcopy(cases.PRESETS["case-a-woven-nlbm"])
+    change(d)
+    with pytest.raises(ValueError) as err:
+        cases.from_dict(d)
+    assert key_fragment in str(err.value), str(err.value)
+    return str(err.value)
+
+
+def test_each_validation_error_names_its_key():
+    _bad(lambda d: d["tools"].update(punch_radus_mm=50.0), "'tools.punch_radus_mm'")
+    _bad(lambda d: d.update(colour="red"), "'colour'")
+    _bad(lambda d: d["blank"].pop("size_mm"), "'blank.size_mm'")
+    _bad(lambda d: d.pop("process"), "[process]")
+    _bad(lambda d: d["holder"].pop("gap_mm"), "'holder.gap_mm'")
+    _bad(lambda d: d["holder"].update(mode="force"), "'holder.force_N'")
+    _bad(lambda d: d["blank"].update(size_mm=100.0), "'blank.size_mm'")  # smaller than the opening
+    _bad(lambda d: d["holder"].update(gap_mm=0.2), "'holder.gap_mm'")  # gap smaller than the stack
+    _bad(lambda d: d["blank"].update(element_size_mm=0.0), "'blank.element_size_mm'")
+    _bad(lambda d: d["blank"].update(element_size_mm=-1.0), "'blank.element_size_mm'")
+    _bad(lambda d: d["tools"].update(punch_radius_mm=-5.0), "'tools.punch_radius_mm'")
+    _bad(lambda d: d["tools"].update(punch_radius_mm=53.0), "'tools.punch_radius_mm'")  # does not fit
+    _bad(lambda d: d["tools"].update(die_fillet_mm=12.0), "'tools.die_fillet_mm'")
+    _bad(lambda d: d["process"].update(stroke_mm="50"), "'process.stroke_mm'")
+    _bad(lambda d: d["process"].update(frames=1), "'process.frames'")
+    _bad(lambda d: d["process"].update(speed_mm_per_s=0.0), "'process.speed_mm_per_s'")
+    _bad(lambda d: d["fabric"].update(bending="cubic"), "'fabric.bending'")
+    _bad(lambda d: d["fabric"].update(preset="silk"), "'fabric.preset'")
+    _bad(lambda d: d["fabric"].update(voce={"b_inf_Nm": 1e-5, "m0_N": 1e-3}), "'fabric.voce.kappa0_per_m'")
+    _bad(lambda d: d["numerics"].update(dtype="float16"), "'numerics.dtype'")
+    _bad(lambda d: d["contact"].update(penalty_stiffness_Pa_per_m=-1.0), "'contact.penalty_stiffness_Pa_per_m'")
+    _bad(lambda d: d["plies"].update(orientations_deg=[]), "'plies.orientations_deg'")
+    # Eight plies of 0.3 mm do not fit a 2 mm gap.
+    def thick(d):
+        d["plies"]["orientations_deg"] = [0.0] * 8
+        d["holder"]["gap_mm"] = 2.0
+    _bad(thick, "'holder.gap_mm'")
+
+
+def test_overrides():
+    case = cases.load("case-a-woven-nlbm")
+    c2 = cases.apply_overrides(case, ["holder.gap_mm=5", "plies.orientations_deg=[0, 45]", "fabric.bending=membrane",
+                                      "numerics.dtype=float64", "fabric.voce.b_inf_Nm=2e-5",
+                                      "fabric.voce.m0_N=7e-3", "fabric.voce.kappa0_per_m=20"])
+    assert c2.holder.gap == pytest.approx(5e-3)
+    assert c2.orientations == pytest.approx((0.0, math.pi / 4))
+    assert c2.fabric.bending == "membrane" and c2.dtype == "float64"
+    assert c2.fabric.voce == (2e-5, 7e-3, 20.0)
+    assert cases.with_element_size(case, 4e-3).element_size == pytest.approx(4e-3)
+    with pytest.raises(ValueError, match="'holder.gpa_mm'"):
+        cases.apply_overrides(case, ["holder.gpa_mm=5"])
+    with pytest.raises(ValueError, match="key=value"):
+        cases.apply_overrides(case, ["holder.gap_mm"])
+    with pytest.raises(ValueError, match="'holder.gap_mm'"):
+        cases.apply_overrides(case, ["holder.gap_mm=0.1"])
+    # Custom Voce law reaches the fabric.
+    fab = cases.build_fabric(cases.apply_overrides(case, ["fabric.voce={b_inf_Nm = 2e-5, m0_N = 7e-3, kappa0_per_m = 20.0}"]))
+    assert float(fab.bending[0].b_inf) == pytest.approx(2e-5)
+
+
+def test_toml_file_roundtrip_and_unknown_names(tmp_path):
+    from jaxform.io.case_file import read_case, write_case
+
+    case = cases.apply_overrides(cases.load("case-b-ncf-nlbm"), ["process.frames=21", "fabric.thickness_mm=0.45"])
+    path = write_case(case, tmp_path / "my.toml")
+    assert cases.load(str(path)) == case
+    assert read_case(path).ply_thickness == pytest.approx(0.45e-3)
+    with pytest.raises(FileExistsError):
+        write_case(case, path)
+    with pytest.raises(ValueError, match="unknown case"):
+        cases.load("case-c-woven")
+    with pytest.raises(FileNotFoundError):
+        cases.load(str(tmp_path / "missing.toml"))
+    bad = tmp_path / "bad.toml"
+    bad.write_text(cases.to_toml(case).replace("[holder]", "[holder]\nclamp = true"))
+    with pytest.raises(ValueError, match="'holder.clamp'"):
+        cases.load(str(bad))
+    (tmp_path / "broken.toml").write_text("name = ")
+    with pytest.raises(ValueError, match="not valid TOML"):
+        cases.load(str(tmp_path / "broken.toml"))

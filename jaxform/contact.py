@@ -42,7 +42,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxform import tools, validate
-from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass
+from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.tools import closest_point_triangle, safe_norm, safe_normalize
 
 
@@ -378,6 +378,92 @@ def holder_step(state: HolderState, reaction_z, *, mass, force, dt, damping=0.0)
     return HolderState(dz=state.dz + dt * vz, vz=vz)
 
 
+# ---------------------------------------------------------------------------------------------
+# Loads for the integrator's external-force hook (jaxform.model: load.force(x, v, t, state))
+# ---------------------------------------------------------------------------------------------
+
+
+@pytree_dataclass
+class ToolLoad:
+    """One rigid tool's contact as an external load of :class:`jaxform.model.Model`.
+
+    ``force(x, v, t, load_state) -> (f (N, 3), new_load_state, extras)``. With
+    ``force_controlled=False`` the tool follows its prescribed motion and ``load_state`` is
+    ``None``; with ``True`` (the Case B holder) ``load_state`` is a :class:`HolderState`, advanced
+    by :func:`holder_step` under ``clamp_force`` with the contact reaction of the same step.
+
+    Attributes:
+        tool: a tool pytree.
+        params: :class:`ContactParams`.
+        offset: () or (N,) mid-surface-to-face distance, m.
+        area: () or (N,) tributary area, m².
+        active: (N,) 0/1 weights of the nodes that may touch this tool (ones for a single ply).
+        clamp_force, mass, damping, dt: holder control (N, kg, N·s/m, s); unused when prescribed.
+        force_controlled: static.
+    """
+
+    tool: Any
+    params: Any
+    offset: Any
+    area: Any
+    active: Any
+    clamp_force: Any = 0.0
+    mass: Any = 1.0
+    damping: Any = 0.0
+    dt: Any = 0.0
+    force_controlled: bool = static_field(default=False)
+
+    def force(self, x, v, t, load_state):
+        if self.force_controlled:
+            dz = load_state.dz
+            vel = jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
+        else:
+            dz, vel = tool_pose(self.tool, t)
+        res = tool_contact(self.tool, x, v, self.offset, self.area, self.params, dz=dz, tool_velocity=vel,
+                           active=self.active)
+        new = load_state
+        if self.force_controlled:
+            new = holder_step(load_state, res.reaction[2], mass=self.mass, force=self.clamp_force, dt=self.dt,
+                              damping=self.damping)
+        extras = {"reaction": res.reaction, "dz": jnp.asarray(dz), "contact_energy": res.energy,
+                  "friction_power": res.friction_power, "max_pressure": jnp.max(res.pressure)}
+        return res.force, new, extras
+
+
+@pytree_dataclass
+class PlyLoad:
+    """Ply–ply contact between two plies of a stack as an external load.
+
+    ``load_state`` is ``(candidates (N_s, K) int32, step () int32)``; the candidate table is rebuilt
+    with :func:`nearest_faces` every ``refresh_every`` calls (static), inside ``lax.cond``.
+
+    Attributes:
+        slave: (N_s,) int; triangles: (F, 3) int; gap0: () m; area: () or (N_s,) m²;
+        params: :class:`ContactParams`; k, refresh_every: static ints.
+    """
+
+    slave: Any
+    triangles: Any
+    gap0: Any
+    area: Any
+    params: Any
+    k: int = static_field(default=8)
+    refresh_every: int = static_field(default=50)
+
+    def initial_state(self, x):
+        """The load state for the initial positions ``x`` (N, 3)."""
+        return (nearest_faces(x, self.slave, self.triangles, self.k), jnp.asarray(0, jnp.int32))
+
+    def force(self, x, v, t, load_state):
+        cand, n = load_state
+        cand = jax.lax.cond(n % self.refresh_every == 0,
+                            lambda: nearest_faces(x, self.slave, self.triangles, self.k), lambda: cand)
+        res = ply_contact(x, v, self.slave, self.triangles, cand, self.gap0, self.area, self.params)
+        extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
+                  "max_pressure": jnp.max(res.pressure)}
+        return res.force, (cand, n + 1), extras
+
+
 __all__ = [
     "ContactParams",
     "ContactResult",
@@ -393,4 +479,6 @@ __all__ = [
     "auto_penalty_stiffness",
     "contact_params",
     "holder_step",
+    "ToolLoad",
+    "PlyLoad",
 ]

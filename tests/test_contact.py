@@ -234,3 +234,48 @@ def test_ply_ply_contact_pressure_friction_and_momentum():
     # Finite gradients.
     gx = jax.jit(jax.grad(lambda xx: contact.ply_contact(xx, v, slave, tri, cand, h, s * s, params).energy))(jnp.asarray(x))
     assert np.all(np.isfinite(gx))
+
+
+def test_tool_load_hook_force_controlled_holder_settles_on_the_fabric():
+    """The integrator hook: a force-controlled holder pressing 1000 N on nodes held in place
+    comes to rest where the contact reaction carries the clamping force."""
+    n = 100
+    area = np.full(n, 5.4e-2 / n)  # the holder ring of the 250 mm blank
+    xs = np.column_stack([np.linspace(0.06, 0.12, n), np.zeros(n), np.full(n, H / 2)])
+    dt = 1e-6
+    params = contact.contact_params(RHO_A, dt, H, friction=0.23)
+    holder = tools.BlankHolder(0.053, bottom_z=H)
+    load = contact.ToolLoad(tool=holder, params=params, offset=H / 2, area=area, active=np.ones(n),
+                            clamp_force=1000.0, mass=5.0, damping=2 * math.sqrt(float(params.stiffness) * 5.4e-2 * 5.0),
+                            dt=dt, force_controlled=True)
+
+    @jax.jit
+    def run(state):
+        def body(s, _):
+            f, s2, ex = load.force(jnp.asarray(xs), jnp.zeros((n, 3)), 0.0, s)
+            return s2, ex["reaction"][2]
+        return jax.lax.scan(body, state, None, length=3000)
+
+    state, rz = run(contact.HolderState())
+    np.testing.assert_allclose(rz[-1], 1000.0, rtol=1e-3)
+    f, _, ex = load.force(jnp.asarray(xs), jnp.zeros((n, 3)), 0.0, state)
+    np.testing.assert_allclose(jnp.sum(f[:, 2]), -1000.0, rtol=1e-3)
+    np.testing.assert_allclose(ex["max_pressure"], 1000.0 / 5.4e-2, rtol=1e-3)
+    # Prescribed tools: the load follows the motion and has no state.
+    punch = tools.Punch(0.05, apex_z=H, motion=tools.VerticalMotion(-0.5))
+    pl = contact.ToolLoad(tool=punch, params=params, offset=H / 2, area=1e-6, active=np.ones(1))
+    f, s, ex = pl.force(jnp.array([[0.0, 0.0, H / 2]]), jnp.zeros((1, 3)), 1e-4, None)
+    assert s is None and float(f[0, 2]) < 0 and float(ex["dz"]) == pytest.approx(-5e-5)
+
+
+def test_ply_load_refreshes_candidates():
+    lower, quads = _flat_ply(4, 4, 2e-3, 0.0)
+    upper, _ = _flat_ply(2, 2, 2e-3, H - 1e-6, offset=(1e-3, 1e-3))
+    x = jnp.asarray(np.vstack([lower, upper]))
+    slave = np.arange(16, 20)
+    load = contact.PlyLoad(slave=slave, triangles=contact.quads_to_triangles(quads), gap0=H, area=4e-6,
+                           params=_params(friction=0.36), k=4, refresh_every=2)
+    st = load.initial_state(x)
+    f, st, ex = jax.jit(load.force)(x, jnp.zeros_like(x), 0.0, st)
+    np.testing.assert_allclose(f[slave, 2], 4e10 * 1e-6 * 4e-6, rtol=1e-9)
+    assert int(st[1]) == 1

@@ -1,8 +1,6 @@
 """Plots of the material laws (the source paper's Figures 1 and 2), host side."""
 from __future__ import annotations
 
-import pathlib
-
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -78,9 +76,4 @@ def shear_figure(fabrics: list[Fabric], *, gamma_max_deg: float = 60.0):
     return fig
 
 
-def save(fig, path) -> pathlib.Path:
-    """Write a figure as PNG and close it."""
-    path = pathlib.Path(path)
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
-    return path
+from jaxform.plots.fields import save  # noqa: E402  (one PNG writer for every plot module)

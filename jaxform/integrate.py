@@ -49,6 +49,9 @@ class SimulationError(RuntimeError):
 class Frames:
     """Saved frames (leading axis: frame).
 
+    A frame is the state after its last step: positions ``x_{n+1}``; the energies are those of
+    that step (positions ``x_n``, one step earlier).
+
     Attributes:
         x: (F, N, 3) positions, m.
         v: (F, N, 3) velocities (half step before the frame), m/s.
@@ -103,24 +106,29 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
 
 
 def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -> State:
-    """The state at t = 0: positions ``x`` (default: the reference), velocities ``v`` (default 0)."""
+    """The state at t = 0: positions ``x`` (default: the reference), velocities ``v`` (default 0).
+
+    ``v`` is the velocity at t = 0; the kinetic energy account starts from it.
+    """
     dtype = model.mass.dtype
     x = jnp.asarray(model.shell.mesh.nodes if x is None else x, dtype)
     v = jnp.zeros_like(x) if v is None else jnp.asarray(v, dtype)
-    f_int, parts = forces_and_energy(x, model.shell)
+    _, parts = forces_and_energy(x, model.shell)
     ke = 0.5 * jnp.sum(model.mass[:, None] * v * v)
     z = jnp.zeros((), dtype)
     e = Energies(ke, parts["tension"], parts["shear"], parts["bending"], z, z, z, z)
     loads = tuple(None for _ in model.loads) if load_states is None else tuple(load_states)
+    zero = jnp.zeros_like(x)
     return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
-                 f_prev=f_int, bad_step=jnp.asarray(-1, jnp.int32), bad_code=jnp.asarray(0, jnp.int32),
-                 scale_max=e.scale())
+                 f_prev=(zero, zero, zero), bad_step=jnp.asarray(-1, jnp.int32),
+                 bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale())
 
 
 def _step(model: Model, state: State, x_ref, blowup_tol):
     dt = model.dt
     m = model.mass[:, None]
     x, v_old, t = state.x, state.v, state.t
+    first = state.step == 0
     f_int, parts = forces_and_energy(x, model.shell)
     f_grav = m * model.gravity
     f_damp = -model.damping * m * v_old
@@ -132,36 +140,41 @@ def _step(model: Model, state: State, x_ref, blowup_tol):
         new_loads.append(ls_new)
         extras.append(ex)
     f_free = f_int + f_grav + f_damp + f_loads
-    v_free = v_old + dt * f_free / m
+    # on the first step the initial velocity is the full-step velocity: advance half a step
+    h = jnp.where(first, 0.5 * dt, dt)
+    v_free = v_old + h * f_free / m
     x_drive = model.drive.position(t + dt)
     v_drive = (x_drive - x) / dt
     v_new = jnp.where(model.fixed, v_drive, v_free)
     x_new = x + dt * v_new
-    dx = 0.5 * dt * (v_old + v_new)
-    reaction = jnp.where(model.fixed, m * (v_new - v_old) / dt - f_free, 0.0)
+    reaction = jnp.where(model.fixed, m * (v_new - v_old) / h - f_free, 0.0)
+    # energies at step n: kinetic with the mid velocity, work by the trapezoidal rule over x_{n-1} -> x_n
+    v_mid = jnp.where(first, v_old, 0.5 * (v_old + v_new))
+    dx = jnp.where(first, 0.0, dt * v_old)
+    fl0, fd0, fr0 = state.f_prev
     e_old = state.energies
     e = Energies(
-        kinetic=0.25 * jnp.sum(m * (v_old * v_old + v_new * v_new)),
+        kinetic=0.5 * jnp.sum(m * v_mid * v_mid),
         tension=parts["tension"],
         shear=parts["shear"],
         bending=parts["bending"],
         gravity_work=jnp.sum(f_grav * (x - x_ref)),
-        external_work=e_old.external_work + jnp.sum(f_loads * dx),
-        boundary_work=e_old.boundary_work + jnp.sum(reaction * dx),
-        damping_work=e_old.damping_work - jnp.sum(f_damp * dx),
+        external_work=e_old.external_work + 0.5 * jnp.sum((fl0 + f_loads) * dx),
+        boundary_work=e_old.boundary_work + 0.5 * jnp.sum((fr0 + reaction) * dx),
+        damping_work=e_old.damping_work - 0.5 * jnp.sum((fd0 + f_damp) * dx),
     )
-    return x_new, v_new, e, tuple(new_loads), tuple(extras)
+    return x_new, v_new, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction)
 
 
 def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
     """Advance one time step (pure). A failed run stays frozen at its last good state."""
     x_ref = model.drive.position(0.0) if x_ref is None else x_ref
     e0 = state.energies if e0 is None else e0
-    x_new, v_new, e, loads, _ = _step(model, state, x_ref, blowup_tol)
-    return _guard(model, state, x_new, v_new, e, loads, e0, blowup_tol)
+    x_new, v_new, e, loads, _, fp = _step(model, state, x_ref, blowup_tol)
+    return _guard(model, state, x_new, v_new, e, loads, fp, e0, blowup_tol)
 
 
-def _guard(model, state, x_new, v_new, e, loads, e0, blowup_tol):
+def _guard(model, state, x_new, v_new, e, loads, f_prev, e0, blowup_tol):
     finite = jnp.all(jnp.isfinite(x_new)) & jnp.all(jnp.isfinite(v_new)) & jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic)
     scale = jnp.maximum(state.scale_max, e.scale())
     tiny = 1e-30 if x_new.dtype == jnp.float64 else 1e-20
@@ -171,12 +184,12 @@ def _guard(model, state, x_new, v_new, e, loads, e0, blowup_tol):
     fail_now = healthy & (code > 0)
     keep = ~healthy | fail_now
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
-                f_prev=state.f_prev, bad_step=jnp.where(fail_now, state.step, state.bad_step),
+                f_prev=f_prev, bad_step=jnp.where(fail_now, state.step, state.bad_step),
                 bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max))
     frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), state, new)
     # bookkeeping fields always advance
     return State(x=frozen.x, v=frozen.v, t=frozen.t, step=state.step + 1, energies=frozen.energies,
-                 loads=frozen.loads, f_prev=state.f_prev, bad_step=new.bad_step, bad_code=new.bad_code,
+                 loads=frozen.loads, f_prev=frozen.f_prev, bad_step=new.bad_step, bad_code=new.bad_code,
                  scale_max=frozen.scale_max)
 
 
@@ -191,8 +204,8 @@ def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint
     x_ref = state.x
 
     def one(s, _):
-        x_new, v_new, e, loads, extras = _step(model, s, x_ref, blowup_tol)
-        return _guard(model, s, x_new, v_new, e, loads, e0, blowup_tol), extras
+        x_new, v_new, e, loads, extras, fp = _step(model, s, x_ref, blowup_tol)
+        return _guard(model, s, x_new, v_new, e, loads, fp, e0, blowup_tol), extras
 
     def chunk(s):
         s, extras = jax.lax.scan(one, s, None, length=every)

@@ -1,0 +1,75 @@
+"""Figures of the calibration fits (host side, matplotlib Agg)."""
+from __future__ import annotations
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def cantilever_fit_figure(fit, profiles, *, title: str = ""):
+    """Measured and fitted profiles (mm), and the fitted M–kappa and B–kappa curves.
+
+    Args:
+        fit: a :class:`jaxform.calibrate.CantileverFit`.
+        profiles: the fitted :class:`jaxform.calibrate.Profile` list (m).
+    """
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.2))
+    ax = axes[0]
+    for i, (p, (xs, zs)) in enumerate(zip(profiles, fit.simulated)):
+        c = f"C{i}"
+        ax.plot(p.x * 1e3, p.z * 1e3, ".", color=c, ms=3, label=f"measured L={p.overhang * 1e3:.0f} mm")
+        ax.plot(np.asarray(xs) * 1e3, np.asarray(zs) * 1e3, "-", color=c, lw=1.5, label="fitted")
+    ax.set_xlabel("x, mm")
+    ax.set_ylabel("z, mm")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.set_title(f"profiles (rmse {fit.rmse * 1e3:.3f} mm)")
+    ax.legend(fontsize=7)
+    kmax = max(fit.kappa_max, 1e-9)
+    k = np.linspace(0.0, 1.5 * kmax, 400)
+    law = fit.law
+    axes[1].plot(k, np.asarray(law.moment(k)), lw=2)
+    axes[1].axvline(kmax, color="grey", ls=":", label="largest curvature in the data")
+    axes[1].set_xlabel("curvature, 1/m")
+    axes[1].set_ylabel("moment per width M, N")
+    axes[1].set_title("fitted M–kappa")
+    axes[1].legend(fontsize=7)
+    axes[2].plot(k, np.asarray(law.stiffness(k)) * 1e3, lw=2)
+    axes[2].axvline(kmax, color="grey", ls=":")
+    axes[2].set_xlabel("curvature, 1/m")
+    axes[2].set_ylabel("B = dM/dkappa, N·mm")
+    det = "determined" if fit.b_inf_determined else "NOT determined"
+    axes[2].set_title(f"B_init {fit.b_init:.3g} N·m, B_inf {fit.b_inf:.3g} N·m ({det})", fontsize=9)
+    for a in axes:
+        a.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
+def shear_fit_figure(fit, gamma, force, *, title: str = ""):
+    """Picture-frame data and the fitted normalised shear force against shear angle (degrees)."""
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    g = np.asarray(gamma)
+    ax.plot(np.degrees(g), force, ".", ms=3, label="data")
+    gg = np.linspace(min(g.min(), 0.0), g.max(), 400)
+    ax.plot(np.degrees(gg), np.asarray(fit.law.force(gg)), lw=2, label=f"fit ({fit.kind}), rmse {fit.rmse:.3g} N/m")
+    ax.set_xlabel("shear angle, deg")
+    ax.set_ylabel("normalised shear force, N/m")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    ax.set_title(title)
+    fig.tight_layout()
+    return fig
+
+
+def save(fig, path, dpi: int = 130):
+    """Write a figure as PNG and close it."""
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return path
+
+
+__all__ = ["cantilever_fit_figure", "shear_fit_figure", "save"]

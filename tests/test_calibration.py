@@ -1,0 +1,152 @@
+"""Cantilever calibration: profile files, parameterisation, interpolation, the fit and its command.
+
+Fast tests use the small JAX stand-in of the cantilever (tests/test_calibration_standin.py) so the
+fitting machinery is checked on its own; the acceptance round trips through jaxform.cantilever are
+in tests/test_calibration_cantilever.py (slow).
+"""
+import functools
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxform import calibrate as C
+from jaxform.io import calibration_files as cf
+from jaxform.materials import VoceBending
+from reference import elastica as E
+from test_calibration_standin import simulate_standin
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+TRUE = dict(b_inf=3e-5, m0=5e-3, kappa0=25.0)  # unlike the presets
+MASS = 0.21
+SMALL = functools.partial(simulate_standin, n=16, steps=4, newton=5)
+
+
+def _profile(L, noise=5e-5, seed=0, n=50):
+    rng = np.random.default_rng(seed)
+    out = SMALL(VoceBending(**TRUE), overhang=L, areal_mass=MASS)
+    x, z = np.asarray(out.x), np.asarray(out.z)
+    xq = np.linspace(0.002, x[-1] * 0.999, n)
+    zq = np.asarray(C.interp_profile(jnp.asarray(xq), out.x, out.z)) + rng.normal(0, noise, n)
+    return C.Profile(xq, zq, L)
+
+
+def test_parameterisation_round_trip_and_b_init_identity():
+    law = VoceBending(**TRUE)
+    q = C.q_from_law(law, "voce")
+    back = C.law_from_q(jnp.asarray(q), "voce")
+    for k in ("b_inf", "m0", "kappa0"):
+        assert float(getattr(back, k)) == pytest.approx(TRUE[k], rel=1e-12)
+    assert float(back.b_init) == pytest.approx(TRUE["b_inf"] + TRUE["m0"] / TRUE["kappa0"], rel=1e-12)
+
+
+def test_cubic_interpolation_is_third_order():
+    s = np.linspace(0, 1, 2001)
+    errs = []
+    for n in (11, 21, 41):
+        xs = np.linspace(0, 1, n) ** 1.2
+        zs = np.sin(2 * xs)
+        got = np.asarray(C.interp_profile(jnp.asarray(s), jnp.asarray(xs), jnp.asarray(zs)))
+        errs.append(np.max(np.abs(got - np.sin(2 * s))))
+    assert errs[2] < errs[1] / 5 < errs[0] / 25
+
+
+def test_peirce_estimate_matches_reference_linear_elastica():
+    b = 3.9e-4
+    r = E.solve_cantilever(b, 0.08, MASS, n=3)
+    est = C.peirce_b(0.08, r["chord_angle"], MASS)
+    assert est == pytest.approx(b, rel=0.05)
+
+
+def test_quick_fit_round_trip_on_standin():
+    prof = _profile(0.09)
+    fit = C.fit_cantilever([prof], areal_mass=MASS, simulate=SMALL, compute_b41_5=False)
+    b_init = TRUE["b_inf"] + TRUE["m0"] / TRUE["kappa0"]
+    assert fit.b_init == pytest.approx(b_init, rel=0.03)
+    assert fit.b_init == pytest.approx(fit.b_inf + fit.m0 / fit.kappa0, rel=1e-12)
+    assert fit.rmse < 1.5 * 5e-5
+    assert np.isfinite([fit.b_inf, fit.m0, fit.kappa0] + list(fit.sigma.values())).all()
+    # rmse is the RMS z-residual at the measured x
+    out = SMALL(fit.law, overhang=0.09, areal_mass=MASS)
+    res = np.asarray(C.interp_profile(jnp.asarray(prof.x), out.x, out.z)) - prof.z
+    assert fit.rmse == pytest.approx(np.sqrt(np.mean(res**2)), rel=1e-6)
+    d = fit.as_dict()
+    for k in ("b_inf_Nm", "m0_N", "kappa0_per_m", "b_init_Nm", "rmse_mm", "b_inf_determined"):
+        assert k in d
+    # this profile reaches only ~2-3 kappa0: B_inf must be flagged
+    assert fit.kappa_max_over_kappa0 < 5 and not fit.b_inf_determined
+
+
+# ----- profile files -------------------------------------------------------------------------
+
+
+def _write(path, x_mm, z_mm, header="x_mm,z_mm"):
+    path.write_text(header + "\n" + "\n".join(f"{a},{b}" for a, b in zip(x_mm, z_mm)) + "\n")
+    return path
+
+
+def test_profile_csv_any_order_gaps_duplicates(tmp_path):
+    x = np.linspace(0, 80, 30)
+    z = -0.01 * x**2
+    idx = np.random.default_rng(0).permutation(30)
+    p = tmp_path / "p.csv"
+    p.write_text("x_mm,z_mm\n" + "\n".join(f"{x[i]},{z[i]}" for i in idx) + "\n10.0,\n10.0,nan\n")
+    xm, zm = cf.read_profile_csv(p, overhang=0.1)
+    assert np.all(np.diff(xm) > 0) and xm.size == 30
+    np.testing.assert_allclose(zm, -0.01 * (xm * 1e3) ** 2 * 1e-3)
+
+
+@pytest.mark.parametrize("case,match", [
+    ("header", "x_mm,z_mm"),
+    ("few", "at least 5"),
+    ("upward", "negative downwards"),
+    ("far", "far from the clamp"),
+    ("beyond", "beyond the overhang"),
+])
+def test_profile_csv_errors(tmp_path, case, match):
+    x = np.linspace(0, 80, 20)
+    z = -0.01 * x**2
+    if case == "header":
+        p = _write(tmp_path / "p.csv", x, z, header="x,z")
+    elif case == "few":
+        p = _write(tmp_path / "p.csv", x[:3], z[:3])
+    elif case == "upward":
+        p = _write(tmp_path / "p.csv", x, -z)
+    elif case == "far":
+        p = _write(tmp_path / "p.csv", x + 60, z)
+    else:
+        p = _write(tmp_path / "p.csv", x, z)
+    with pytest.raises(ValueError, match=match):
+        cf.read_profile_csv(p, overhang=0.05 if case == "beyond" else 0.2)
+
+
+# ----- the command ---------------------------------------------------------------------------
+
+
+def test_fit_cantilever_command(tmp_path):
+    prof = _profile(0.09, seed=3)
+    csv = cf.write_profile_csv(tmp_path / "p.csv", prof.x, prof.z)
+    out = tmp_path / "params.json"
+    env = dict(os.environ, PYTHONPATH=str(ROOT / "tests") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    cmd = [sys.executable, str(ROOT / "calibration" / "fit_cantilever.py"), "--profile", str(csv), "--overhang-mm", "90",
+           "--areal-mass-gsm", "210", "--out", str(out), "--plot", str(tmp_path / "fit.png"),
+           "--simulate", "test_calibration_cantilever_cli_standin:simulate", "--no-standard-test"]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
+    assert r.returncode == 0, r.stderr
+    d = json.loads(out.read_text())
+    b_init = TRUE["b_inf"] + TRUE["m0"] / TRUE["kappa0"]
+    assert d["b_init_Nm"] == pytest.approx(b_init, rel=0.03)
+    assert d["b_init_Nm"] == pytest.approx(d["b_inf_Nm"] + d["m0_N"] / d["kappa0_per_m"], rel=1e-12)
+    assert d["b_inf_determined"] is False and np.isfinite(d["b_inf_Nm"])
+    assert (tmp_path / "fit.png").stat().st_size > 1000
+    r2 = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
+    assert r2.returncode != 0 and "refusing to overwrite" in r2.stderr
+    bad = _write(tmp_path / "bad.csv", np.linspace(0, 80, 20), 0.01 * np.linspace(0, 80, 20) ** 2)
+    r3 = subprocess.run(cmd[:2] + ["--profile", str(bad)] + cmd[4:] + ["--force"], capture_output=True, text=True,
+                        cwd=ROOT, env=env)
+    assert r3.returncode == 2 and "negative downwards" in r3.stderr

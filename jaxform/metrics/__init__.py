@@ -4,6 +4,8 @@
   mesh or an analytic tool such as :class:`HemisphereRig`).
 - :func:`principal_curvatures`: nodal principal curvatures by iterative quadric fitting (B.1-B.9);
   :func:`kappa_max` (eq. 2).
+- :mod:`jaxform.metrics.wrinkles`: ``d_crit``, zones (wrinkle / bridging / conforming), wrinkle
+  radius, sections and their normalised RMSE, wrinkle counts, ``M_f^RMS`` and densities.
 """
 from jaxform.metrics.curvature import (
     CurvatureStencil,
@@ -22,7 +24,38 @@ from jaxform.metrics.distance import (
     tool_distance,
 )
 
+from jaxform.metrics.wrinkles import (
+    BRIDGING,
+    CONFORMING,
+    WRINKLE,
+    classify_zones,
+    count_section_wrinkles,
+    count_wrinkle_regions,
+    d_crit,
+    node_areas,
+    probability_density,
+    rms_fibre_moment,
+    section_nrmse,
+    section_profile,
+    wrinkle_radius,
+    zone_areas,
+)
+
 __all__ = [
+    "BRIDGING",
+    "CONFORMING",
+    "WRINKLE",
+    "classify_zones",
+    "count_section_wrinkles",
+    "count_wrinkle_regions",
+    "d_crit",
+    "node_areas",
+    "probability_density",
+    "rms_fibre_moment",
+    "section_nrmse",
+    "section_profile",
+    "wrinkle_radius",
+    "zone_areas",
     "CurvatureStencil",
     "MeshWarning",
     "curvature_stencil",

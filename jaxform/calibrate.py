@@ -339,6 +339,7 @@ def fit_cantilever(
     if law not in ("voce", "linear"):
         raise ValueError(f"fit_cantilever: law = {law!r}: must be 'voce' or 'linear'")
     profiles = _as_profiles(profiles)
+    default_model = simulate is None
     simulate = simulate or _default_simulate()
     kw = dict(simulate_kwargs or {})
     dtype = jnp.result_type(float)  # float64 when x64 is on
@@ -437,7 +438,8 @@ def fit_cantilever(
         determined = bool(ratio >= DETERMINED_RATIO and rel < 0.25)
     b41 = float("nan")
     if compute_b41_5:
-        b41 = standard_test_b(fitted, areal_mass, simulate=simulate, simulate_kwargs=kw, g=g)
+        b41 = standard_test_b(fitted, areal_mass, simulate=None if default_model else simulate,
+                              simulate_kwargs=kw, g=g)
     return CantileverFit(
         law=fitted, law_kind=law, b_inf=b_inf, m0=m0, kappa0=kappa0, b_init=b_init,
         sigma={"b_inf": float(sig[0]), "m0": float(sig[1]), "kappa0": float(sig[2]) if law != "linear" else float("nan"),

@@ -481,7 +481,14 @@ def distance_to_index(nodes, index: ToolIndex):
     nodes = jnp.asarray(nodes)
     if not jnp.issubdtype(nodes.dtype, jnp.floating):
         nodes = nodes.astype(jnp.result_type(float))
-    return _distance_to_index_jit(nodes, index)
+    # Pad the node count to a few bucket sizes, so that calls with different numbers of nodes
+    # share compiled programs (padding rows repeat the last node and are dropped).
+    n = nodes.shape[0]
+    if n == 0:
+        return jnp.zeros((0,), nodes.dtype)
+    n_pad = max(64, 1 << (n - 1).bit_length()) if n <= 1024 else -(-n // 1024) * 1024
+    padded = jnp.concatenate([nodes, jnp.broadcast_to(nodes[-1:], (n_pad - n, 3))], axis=0)
+    return _distance_to_index_jit(padded, index)[:n]
 
 
 # ----------------------------------------------------------------------------------------------

@@ -150,6 +150,13 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
     ms = float(case.mass_scaling)
     stable = stable_time_step(shell, mass_scale=ms, safety=1.0)
     dt_max = dt_safety * stable if dt is None else float(dt)
+    # the automatic penalty stiffness k = safety rho_A / dt^2 must keep the penetration under
+    # 1e5 Pa below 10% of the ply (contact_params checks it): on coarse meshes that caps dt
+    c = case.contact
+    if c.penalty_stiffness is None and dt is None:
+        rho_a = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
+        dt_contact = math.sqrt(c.safety * rho_a * 0.1 * float(case.ply_thickness) / 1.0e5)
+        dt_max = min(dt_max, 0.98 * dt_contact)
     T = _cases.stroke_time(case)
     n_int = int(case.process.frames) - 1
     every = samples_per_frame * max(1, math.ceil(T / dt_max / (n_int * samples_per_frame)))
@@ -205,7 +212,8 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
                                  gravity=(0.0, 0.0, -GRAVITY / ms), loads=tuple(loads), dtype=jdtype)
     x0 = jnp.asarray(mesh.nodes, jdtype)
     load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
-    state = integrate.init_state(model, load_states=tuple(load_states))
+    # jitted: eager (op-by-op) evaluation of the shell forces costs seconds
+    state = jax.jit(lambda m, ls: integrate.init_state(m, load_states=ls))(model, tuple(load_states))
     mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=np.asarray(mesh.faces), ply_id=ply_id,
@@ -342,7 +350,8 @@ class FormingResult:
             ``punch_displacement``, ``punch_force``, ``holder_force``, energies...);
         faces, ply_id: mesh connectivity (F, 4) and (N,) ply numbers; info: :class:`RunInfo`;
         complete: bool; reason: why it stopped early (None when complete); wall_time_s; summary:
-        dict (see :func:`summarize`); final_state: last :class:`~jaxform.model.State`.
+        dict (see :func:`summarize`); final_state: last :class:`~jaxform.model.State`; model: the
+        :class:`~jaxform.model.Model` that ran.
     """
 
     t: np.ndarray
@@ -357,6 +366,7 @@ class FormingResult:
     wall_time_s: float
     summary: dict
     final_state: Any = None
+    model: Any = None
 
     @property
     def shear_angle_deg(self) -> np.ndarray:
@@ -471,7 +481,7 @@ def simulate(case, *, dtype=None, element_size: float | None = None, overrides=(
         t=np.asarray(frames_t), x=np.asarray(frames_x),
         fields={k: np.asarray(v) for k, v in frames_f.items()},
         history={k: np.asarray(v) for k, v in hist.items()}, faces=info.faces, ply_id=ply_id, info=info,
-        complete=complete, reason=reason, wall_time_s=wall, summary={}, final_state=state)
+        complete=complete, reason=reason, wall_time_s=wall, summary={}, final_state=state, model=model)
     result.summary = summarize(result)
     return result
 

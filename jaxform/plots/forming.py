@@ -1,0 +1,43 @@
+"""Plots of a forming run (host side): shear-angle map, out-of-plane deviation map, punch force curve."""
+from __future__ import annotations
+
+import numpy as np
+
+from jaxform.plots.fields import curve, field_map
+
+
+def _top_ply(result, k: int = -1):
+    """Positions, faces and node selection of ply 1 at frame ``k``."""
+    sel = result.ply_id == 1
+    idx = np.nonzero(sel)[0]
+    remap = -np.ones(len(sel), np.int64)
+    remap[idx] = np.arange(len(idx))
+    faces = result.faces[np.all(sel[result.faces], axis=1)]
+    return result.x[k][idx], remap[faces], idx
+
+
+def shear_map(result, k: int = -1):
+    """Shear angle (degrees) of ply 1 at frame ``k``, top view of the deformed ply."""
+    x, faces, idx = _top_ply(result, k)
+    g = np.degrees(result.fields["shear_angle"][k][idx])
+    lim = max(float(np.max(np.abs(g))), 1e-6)
+    return field_map(x, faces, g, title=f"shear angle, t = {result.t[k] * 1e3:.1f} ms", label="shear angle (°)",
+                     cmap="RdBu_r", vmin=-lim, vmax=lim)
+
+
+def deviation_map(result, k: int = -1):
+    """Out-of-plane deviation from the tool surface (mm) of ply 1 at frame ``k``."""
+    x, faces, idx = _top_ply(result, k)
+    d = np.maximum(result.fields["deviation"][k][idx], 0.0) * 1e3
+    return field_map(x, faces, d, title=f"deviation from the tools, t = {result.t[k] * 1e3:.1f} ms",
+                     label="deviation (mm)", cmap="magma")
+
+
+def punch_force_curve(result):
+    """Punch force (N) against punch displacement (mm)."""
+    h = result.history
+    return curve(np.asarray(h["punch_displacement"]) * 1e3, h["punch_force"], xlabel="punch displacement (mm)",
+                 ylabel="punch force (N)", title=f"{result.info.case.name}: punch force")
+
+
+__all__ = ["shear_map", "deviation_map", "punch_force_curve"]

@@ -1,0 +1,105 @@
+"""``jaxform run``: outputs, refusal of a user's directory, interrupted and failed runs (coarse mesh)."""
+import json
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+import pytest
+
+from jaxform.cli import main
+
+FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]
+FIELDS = ("displacement", "shear_angle_deg", "fibre_strain", "bending_moment", "M_f_rms", "contact_pressure",
+          "deviation", "ply_id")
+
+
+def _pvd_files(out):
+    root = ET.parse(out / "frames.pvd").getroot()
+    return [(float(d.get("timestep")), d.get("file")) for d in root.iter("DataSet")]
+
+
+def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 0
+    text = capsys.readouterr().out
+    assert "complete" in text and "frames.pvd" in text
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is True and s["reason"] is None
+    for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s"):
+        assert isinstance(s[key], float) and np.isfinite(s[key])
+    assert s["inputs"]["blank"]["element_size_mm"] == 25.0 and s["inputs"]["process"]["stroke_mm"] == 4.0
+    assert s["versions"]["jax"] and s["versions"]["jaxform"]
+    h = s["history"]
+    assert len(h["t_s"]) == len(h["punch_force_N"]) == len(h["energies_J"]["kinetic"]) > 10
+    assert h["punch_displacement_m"][-1] == pytest.approx(4e-3, rel=1e-3)
+    assert set(s["draw_in"]) >= {"edge_mid_m", "corner_m"}
+    frames = _pvd_files(tmp_out)
+    assert len(frames) == 3 and frames[0][0] == 0.0
+    m = meshio.read(tmp_out / frames[-1][1])
+    for f in FIELDS:
+        assert f in m.point_data, f
+    assert m.points.shape == (121, 3) and m.cells[0].type == "quad"
+    # points at their deformed positions: the centre went down with the punch
+    assert m.points[:, 2].min() == pytest.approx(0.15e-3 - 4e-3, abs=0.2e-3)
+    np.testing.assert_allclose(m.point_data["displacement"], m.points - meshio.read(tmp_out / frames[0][1]).points,
+                               atol=1e-6)
+    for png in ("shear_angle.png", "deviation.png", "punch_force.png"):
+        assert (tmp_out / png).read_bytes()[:4] == b"\x89PNG"
+    # a second run may replace its own output
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--set", "process.frames=2"]) == 0
+    assert len(_pvd_files(tmp_out)) == 2
+
+
+def test_run_refuses_a_users_directory(tmp_out, capsys):
+    tmp_out.mkdir()
+    (tmp_out / "keep.txt").write_text("mine")
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 2
+    assert "not empty" in capsys.readouterr().err
+    assert sorted(p.name for p in tmp_out.iterdir()) == ["keep.txt"]
+
+
+def test_run_rejects_bad_input(tmp_out, capsys):
+    assert main(["run", "case-z", "--out", str(tmp_out)]) == 2
+    assert "unknown case" in capsys.readouterr().err
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), "--set", "holder.gap_mm=0.1"]) == 2
+    assert "holder.gap_mm" in capsys.readouterr().err
+
+
+def test_interrupted_run_keeps_its_frames_and_says_so(tmp_out, monkeypatch):
+    from jaxform.cli import run as run_mod
+
+    calls = {"n": 0}
+    original = run_mod.Progress.__call__
+
+    def interrupt(self, step, n_steps, *a):
+        calls["n"] += 1
+        if step > n_steps * 0.6:
+            raise KeyboardInterrupt
+        return original(self, step, n_steps, *a)
+
+    monkeypatch.setattr(run_mod.Progress, "__call__", interrupt)
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 130
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False and "KeyboardInterrupt" in s["reason"]
+    frames = _pvd_files(tmp_out)
+    assert len(frames) == 2  # the start and the first frame interval
+    for _, name in frames:
+        assert meshio.read(tmp_out / name).points.shape == (121, 3)
+    assert s["frames_written"] == 2
+
+
+def test_failed_run_keeps_its_frames_and_says_why(tmp_out):
+    from jaxform import cases
+    from jaxform.cli.run import execute
+
+    case = cases.apply_overrides(cases.with_element_size(cases.load("case-a-woven-nlbm"), 25e-3),
+                                 ["process.stroke_mm=4", "process.frames=3", "contact.penalty_stiffness_Pa_per_m=1e11"])
+    # a time step far above the stable limit (shell and contact) blows up in the first interval
+    with pytest.warns(RuntimeWarning, match="stable"):
+        result, written = execute(case, tmp_out, quiet=True, dt=2e-5)
+    assert not result.complete and result.reason.startswith("simulation failed")
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False and "failed" in s["reason"]
+    frames = _pvd_files(tmp_out)
+    assert len(frames) >= 1
+    for _, name in frames:
+        assert np.all(np.isfinite(meshio.read(tmp_out / name).points))

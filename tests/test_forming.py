@@ -1,0 +1,105 @@
+"""Forming runs end to end on coarse meshes (issue 4): wiring, Case B contact and holder force,
+gradients of a short run against finite differences."""
+import dataclasses
+import math
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+import pytest
+
+from jaxform import cases, contact, forming
+
+
+def _coarse(name, size_mm=25.0, **keys):
+    case = cases.with_element_size(cases.load(name), size_mm * 1e-3)
+    return cases.apply_overrides(case, [f"{k.replace('__', '.')}={v}" for k, v in keys.items()])
+
+
+def test_build_wires_case_b():
+    case = _coarse("case-b-ncf-nlbm", process__frames=3)
+    model, state, info = forming.build(case)
+    h = case.ply_thickness
+    n = len(info.x0)
+    assert len(model.loads) == 4 and info.n_ply_loads == 1
+    # ply 1 on top at 1.5 h, ply 2 at h/2 on the die
+    np.testing.assert_allclose(info.x0[info.ply_id == 1, 2], 1.5 * h)
+    np.testing.assert_allclose(info.x0[info.ply_id == 2, 2], 0.5 * h)
+    punch, die, holder, ply = model.loads
+    np.testing.assert_array_equal(np.asarray(punch.active), (info.ply_id == 1).astype(float))
+    np.testing.assert_array_equal(np.asarray(die.active), (info.ply_id == 2).astype(float))
+    assert holder.force_controlled and float(holder.clamp_force) == 1000.0
+    assert isinstance(state.loads[2], contact.HolderState)
+    # slaves: ply 1; master triangles: ply 2's, facing up
+    assert set(np.asarray(ply.slave).tolist()) == set(np.nonzero(info.ply_id == 1)[0].tolist())
+    tri = np.asarray(ply.triangles)
+    p = info.x0[tri]
+    assert np.all(info.ply_id[tri] == 2)
+    assert np.all(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])[:, 2] > 0)
+    # whole steps per frame, the stroke exactly covered
+    assert info.n_steps * info.dt == pytest.approx(cases.stroke_time(case), rel=1e-12)
+    assert info.every % info.samples_per_frame == 0
+    assert n == 2 * 11 * 11
+    # NCF fibres at +-45 degrees (orientation 0)
+    assert model.shell.fabrics[0].fibre_angles == pytest.approx((math.pi / 4, -math.pi / 4))
+
+
+def test_orientations_rotate_the_fibres():
+    case = _coarse("case-a-woven-nlbm", plies__orientations_deg="[30.0]")
+    model, _, _ = forming.build(case)
+    assert model.shell.fabrics[0].fibre_angles == pytest.approx((math.radians(30), math.radians(120)))
+
+
+def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N():
+    case = _coarse("case-b-woven-nlbm", size_mm=12.5, process__stroke_mm=6, process__frames=2)
+    r = forming.simulate(case, samples_per_frame=12)
+    assert r.complete, r.reason
+    h = case.ply_thickness
+    t = r.history["t"]
+    seated = t > 0.5 * t[-1]
+    np.testing.assert_allclose(r.history["holder_force"][seated], 1000.0, rtol=0.02)
+    # ply 1 on ply 2: no interpenetration beyond 10% of the thickness; under the holder they touch
+    model, s = r.model, r.final_state
+    pl = model.loads[3]
+    res = contact.ply_contact(s.x, s.v, pl.slave, pl.triangles, s.loads[3][0], pl.gap0, pl.area, pl.params)
+    gap = np.asarray(res.gap)
+    assert gap.min() > -0.1 * h
+    x0 = r.info.x0[np.asarray(pl.slave)]
+    under = np.hypot(x0[:, 0], x0[:, 1]) > case.tools.holder_opening_radius + 0.01
+    assert np.all(np.abs(gap[under]) < 0.1 * h)
+    # the summary holds the SPEC keys
+    for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s", "complete"):
+        assert key in r.summary
+
+
+def test_gradients_of_a_short_run_match_finite_differences():
+    """d(mean flange lift)/d(b_inf, first shear coefficient), float64, against central differences."""
+    case = _coarse("case-a-woven-nlbm", process__stroke_mm=3, process__frames=2, process__speed_mm_per_s=2000.0,
+                   numerics__dtype='"float64"')
+    model, state, info = forming.build(case, samples_per_frame=1)
+    fab = model.shell.fabrics[0]
+    law = fab.bending[0]
+    c0 = jnp.asarray(fab.shear.coeffs)
+    r0 = np.hypot(info.x0[:, 0], info.x0[:, 1])
+    ring = jnp.asarray((r0 > 0.06) & (r0 < 0.1), float)
+    h = case.ply_thickness
+
+    def out(b_inf, c1):
+        new_law = dataclasses.replace(law, b_inf=b_inf)
+        shear = dataclasses.replace(fab.shear, coeffs=c0.at[0].set(c1))
+        m = forming.with_fabric(model, fab.replace(bending=(new_law, new_law), shear=shear))
+        s, _ = forming.rollout(m, state, info)
+        z = s.x[:, 2] - 0.5 * h
+        return jnp.sum(ring * z) / jnp.sum(ring) * 1e3  # mm
+
+    b, c = float(law.b_inf), float(c0[0])
+    f = jax.jit(out)
+    g = jax.jit(jax.grad(out, argnums=(0, 1)))(b, c)
+    for i, (x, dx) in enumerate(((b, 1e-3 * b), (c, 1e-3 * c))):
+        args_p = [b, c]
+        args_m = [b, c]
+        args_p[i] = x + dx
+        args_m[i] = x - dx
+        fd = (float(f(*args_p)) - float(f(*args_m))) / (2 * dx)
+        assert np.isfinite(float(g[i]))
+        assert float(g[i]) == pytest.approx(fd, rel=1e-3, abs=1e-12 + 1e-3 * abs(fd))

@@ -60,7 +60,7 @@ class RunInfo:
         case: the :class:`~jaxform.cases.Case`.
         dt: time step, s; every: steps per frame interval; samples_per_frame: host chunks per frame.
         n_frames: frames including the initial one; n_steps: total steps; stroke_time: s.
-        faces: (F, 4) quads of all plies (node indices); ply_id: (N,) 1-based ply of each node.
+        faces: (F, 4) quads of all plies (node indices, for output); ply_id: (N,) 1-based ply of each node.
         x0: (N, 3) initial positions, m.
         edge_mid: (4,) node indices of ply 1's edge mid-sides (+x, -x, +y, -y); corners: (4,).
         n_ply_loads: number of ply–ply loads (after the three tools).
@@ -88,13 +88,45 @@ class RunInfo:
 
 
 def build_mesh(case) -> Mesh:
-    """The blank: one ``blank_size`` square of ``element_size`` quads per ply, ply 1 on top (m)."""
+    """The blank: one ``blank_size`` square of about ``element_size`` quads per ply, ply 1 on top (m).
+
+    Each quad is split into two triangles along alternating diagonals ("union jack"), with an even
+    number of quads along each side (the element size is rounded to make it so): the triangulation
+    is then mirror-symmetric about both blank axes, like the fabric and the rig. (A single diagonal
+    direction makes the +45° and -45° directions respond differently and the shear map loses its
+    mirror symmetry.) ``mesh.faces`` gives triangles; :func:`grid_quads` the quads for output.
+    """
     n = case.n_plies
-    mesh = Mesh.square(case.blank_size, case.element_size, plies=n, ply_spacing=0.0)
+    nq = 2 * max(1, int(round(case.blank_size / (2.0 * case.element_size))))
+    xs = np.linspace(-0.5 * case.blank_size, 0.5 * case.blank_size, nq + 1)
+    mesh = Mesh.grid(xs, xs, plies=n, ply_spacing=0.0)
     nodes = np.array(mesh.nodes, dtype=np.float64)
     for (a, b), z in zip(mesh.ply_nodes, _cases.ply_heights(case)):
         nodes[a:b, 2] = z
-    return mesh.replace(nodes=nodes)
+    quads = grid_quads(nq + 1, nq + 1)
+    i, j = np.meshgrid(np.arange(nq), np.arange(nq), indexing="xy")
+    even = ((i + j) % 2 == 0).ravel()
+    p, q, s, r = quads[:, 0], quads[:, 1], quads[:, 2], quads[:, 3]
+    t1 = np.where(even[:, None], np.stack([p, q, s], 1), np.stack([p, q, r], 1))
+    t2 = np.where(even[:, None], np.stack([p, s, r], 1), np.stack([q, s, r], 1))
+    tris1 = np.stack([t1, t2], 1).reshape(-1, 3)
+    npp = (nq + 1) ** 2
+    tris = np.concatenate([tris1 + k * npp for k in range(n)]).astype(np.int32)
+    e1 = nodes[tris[:, 1]] - nodes[tris[:, 0]]
+    e2 = nodes[tris[:, 2]] - nodes[tris[:, 0]]
+    area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+    node_area = np.zeros(len(nodes))
+    np.add.at(node_area, tris.ravel(), np.repeat(area / 3.0, 3))
+    return mesh.replace(nodes=nodes, tris=tris, node_area=node_area, quads=False)
+
+
+def grid_quads(nx: int, ny: int, plies: int = 1) -> np.ndarray:
+    """(Q, 4) counter-clockwise quads (p, q, s, r) of an ``nx`` x ``ny`` node grid, per ply stacked."""
+    idx = np.arange(nx * ny).reshape(ny, nx)
+    p, q = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
+    r, s = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    one = np.stack([p, q, s, r], 1)
+    return np.concatenate([one + k * nx * ny for k in range(plies)]).astype(np.int64)
 
 
 def ply_fabrics(case, fabric=None) -> tuple:
@@ -216,7 +248,7 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
     state = jax.jit(lambda m, ls: integrate.init_state(m, load_states=ls))(model, tuple(load_states))
     mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
-                   n_steps=n_int * every, stroke_time=T, faces=np.asarray(mesh.faces), ply_id=ply_id,
+                   n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies), ply_id=ply_id,
                    x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners, n_ply_loads=case.n_plies - 1,
                    stable_dt=stable)
     return model, state, info
@@ -519,40 +551,46 @@ def flange_mask(x_ref, case) -> np.ndarray:
     return r > float(case.tools.die_opening_radius + case.tools.die_fillet)
 
 
-def wrinkle_count(x, deviation, case, *, radius: float | None = None, threshold: float = 0.5e-3,
-                  n_samples: int = 720) -> int:
-    """Number of out-of-plane waves around the flange: peaks of the deviation above ``threshold``
-    (m) along a circle of ``radius`` (default: 10 mm outside the die fillet) in the current
-    configuration (nearest node sampling)."""
+def flange_profile(x, deviation, radius: float, n_samples: int = 720):
+    """Deviation (m) along a circle of ``radius`` (m) about the punch axis, current configuration
+    (nearest node of ply 1's top view): ``(angles (n,) rad, values (n,))``."""
     x = np.asarray(x)
-    dev = np.asarray(deviation)
-    rad = float(case.tools.die_opening_radius + case.tools.die_fillet) + 10e-3 if radius is None else radius
     th = np.linspace(0, 2 * np.pi, n_samples, endpoint=False)
-    pts = np.stack([rad * np.cos(th), rad * np.sin(th)], 1)
+    pts = np.stack([radius * np.cos(th), radius * np.sin(th)], 1)
     d2 = np.sum((pts[:, None, :] - x[None, :, :2]) ** 2, -1)
-    prof = dev[np.argmin(d2, axis=1)]
-    above = prof > threshold
-    if above.all() or not above.any():
-        return int(above.all())
-    # count runs of "above" on the circle
-    starts = np.sum(above & ~np.roll(above, 1))
-    return int(starts)
+    return th, np.asarray(deviation)[np.argmin(d2, axis=1)]
 
 
-def symmetry_error(x_ref, values, faces=None) -> dict:
-    """Mirror symmetry of a nodal field about the x and y axes of the blank (structured grid).
+def wrinkle_count(x, deviation, case, *, radius: float | None = None, prominence: float = 0.5e-3,
+                  n_samples: int = 720) -> int:
+    """Number of discrete out-of-plane waves around the flange: peaks of the deviation along a
+    circle of ``radius`` (default 10 mm outside the die fillet) standing out by more than
+    ``prominence`` (m) from the troughs beside them. A flange lifted uniformly counts 0."""
+    from scipy.signal import find_peaks
 
-    Returns ``{"x": e_x, "y": e_y}``: ``max |v - v_mirror| / max |v|``, with the mirror node found
-    by reference position.
+    rad = float(case.tools.die_opening_radius + case.tools.die_fillet) + 10e-3 if radius is None else radius
+    _, prof = flange_profile(x, deviation, rad, n_samples)
+    ext = np.concatenate([prof, prof, prof])
+    peaks, _ = find_peaks(ext, prominence=prominence)
+    return int(np.sum((peaks >= n_samples) & (peaks < 2 * n_samples)))
+
+
+def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
+    """Mirror symmetry of a nodal field about the x and y axes of the blank.
+
+    Returns ``{"x": e_x, "y": e_y}``: ``max |v - s v_mirror| / max |v|`` with the mirror node found
+    by reference position and ``s = -1`` for fields that change sign under a mirror (``odd``: the
+    shear angle of a 0/90° fabric), else 1.
     """
     x_ref = np.asarray(x_ref)
     v = np.asarray(values)
+    sign = -1.0 if odd else 1.0
     key = np.round(x_ref[:, :2] * 1e6).astype(np.int64)
     lut = {(a, b): i for i, (a, b) in enumerate(map(tuple, key))}
     out = {}
     for name, sx, sy in (("x", 1, -1), ("y", -1, 1)):
         idx = np.array([lut.get((sx * a, sy * b), i) for i, (a, b) in enumerate(map(tuple, key))])
-        out[name] = float(np.max(np.abs(v - v[idx])) / max(np.max(np.abs(v)), 1e-30))
+        out[name] = float(np.max(np.abs(v - sign * v[idx])) / max(np.max(np.abs(v)), 1e-30))
     return out
 
 
@@ -608,5 +646,5 @@ def summarize(result: FormingResult) -> dict:
     return s
 
 
-__all__ = ["build", "build_mesh", "ply_fabrics", "with_fabric", "run_steps", "state_fields", "rollout", "simulate",
-           "FormingResult", "RunInfo", "draw_in", "flange_mask", "wrinkle_count", "symmetry_error", "summarize"]
+__all__ = ["build", "build_mesh", "grid_quads", "ply_fabrics", "with_fabric", "run_steps", "state_fields", "rollout", "simulate",
+           "FormingResult", "RunInfo", "draw_in", "flange_mask", "wrinkle_count", "flange_profile", "symmetry_error", "summarize"]

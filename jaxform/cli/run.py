@@ -125,12 +125,12 @@ def execute(case, out, *, force=False, quiet=False, stream=None, element_size=No
 
     progress = Progress(stream=stream, quiet=quiet)
     # the faces are known only after building: peek through a tiny wrapper
-    from jaxform.forming import build_mesh
+    from jaxform.forming import build_mesh, grid_quads
 
     mesh = build_mesh(case)
     import numpy as np
 
-    state["faces"] = np.asarray(mesh.faces)
+    state["faces"] = grid_quads(*mesh.shape, plies=case.n_plies)
     ply = np.zeros(mesh.n_nodes, np.int32)
     for i, (a, b) in enumerate(mesh.ply_nodes):
         ply[a:b] = i + 1

@@ -245,13 +245,18 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
     x0 = jnp.asarray(mesh.nodes, jdtype)
     load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
     # jitted: eager (op-by-op) evaluation of the shell forces costs seconds
-    state = jax.jit(lambda m, ls: integrate.init_state(m, load_states=ls))(model, tuple(load_states))
+    state = _init_state(model, tuple(load_states))
     mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies), ply_id=ply_id,
                    x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners, n_ply_loads=case.n_plies - 1,
                    stable_dt=stable)
     return model, state, info
+
+
+@jax.jit
+def _init_state(model, load_states):
+    return integrate.init_state(model, load_states=load_states)
 
 
 def with_fabric(model, fabric):
@@ -279,6 +284,9 @@ def run_steps(model, state, e0, x_ref, n: int, blowup_tol: float = 1e30):
         return integrate.step(model, s, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol), None
 
     return jax.lax.scan(one, state, None, length=n)[0]
+
+
+_run_steps_jit = jax.jit(run_steps, static_argnames=("n", "blowup_tol"))
 
 
 def _tool_pose(load, t, ls):
@@ -357,14 +365,20 @@ def state_fields(model, state, ply_id, n_plies: int):
     return out
 
 
-def rollout(model, state, info: RunInfo, *, n_frames: int | None = None, checkpoint: bool = True):
+_fields_jit = jax.jit(state_fields, static_argnames=("n_plies",))
+
+
+def rollout(model, state, info: RunInfo, *, n_frames: int | None = None, checkpoint: bool = True,
+            blowup_tol: float = 1e30):
     """Pure, differentiable run of ``n_frames - 1`` frame intervals (default: the whole stroke).
 
     Returns ``(final_state, frames)`` (:class:`jaxform.integrate.Frames`, the initial frame not
-    included). Use inside ``jax.grad``/``jax.jit`` (``info`` is static: close over it).
+    included). Use inside ``jax.grad``/``jax.jit`` (``info`` is static: close over it). The
+    integrator's relative blow-up guard is off by default (see :func:`run_steps`); check
+    ``final_state.bad_step < 0`` and the finiteness of what you use.
     """
     nf = info.n_frames if n_frames is None else int(n_frames)
-    return integrate.rollout(model, state, nf - 1, info.every, checkpoint=checkpoint)
+    return integrate.rollout(model, state, nf - 1, info.every, checkpoint=checkpoint, blowup_tol=blowup_tol)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -441,8 +455,9 @@ def simulate(case, *, dtype=None, element_size: float | None = None, overrides=(
     model, state, info = build(case, dtype=dtype, fabric=fabric, samples_per_frame=samples_per_frame,
                                damping=damping, dt=dt)
     ply_id = info.ply_id
-    fields_fn = jax.jit(lambda m, s: state_fields(m, s, ply_id, case.n_plies))
-    chunk_fn = jax.jit(run_steps, static_argnames=("n",))
+    ply_arr = jnp.asarray(ply_id)
+    fields_fn = lambda m, s: _fields_jit(m, s, ply_arr, n_plies=case.n_plies)  # noqa: E731
+    chunk_fn = _run_steps_jit
     e0, x_ref = state.energies, state.x
     floor = ENERGY_FLOOR["float64" if state.x.dtype == jnp.float64 else "float32"]
 

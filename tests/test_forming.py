@@ -73,33 +73,34 @@ def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N():
 
 
 def test_gradients_of_a_short_run_match_finite_differences():
-    """d(mean flange lift)/d(b_inf, first shear coefficient), float64, against central differences."""
+    """d(outputs)/d(b_inf, first shear coefficient) of a 3 mm stroke, float64, against central
+    differences: the mean sag (mm) of the blank inside r = 70 mm and the mean squared displacement."""
     case = _coarse("case-a-woven-nlbm", process__stroke_mm=3, process__frames=2, process__speed_mm_per_s=2000.0,
                    numerics__dtype='"float64"')
     model, state, info = forming.build(case, samples_per_frame=1)
     fab = model.shell.fabrics[0]
     law = fab.bending[0]
     c0 = jnp.asarray(fab.shear.coeffs)
-    r0 = np.hypot(info.x0[:, 0], info.x0[:, 1])
-    ring = jnp.asarray((r0 > 0.06) & (r0 < 0.1), float)
-    h = case.ply_thickness
+    X = jnp.asarray(info.x0)
+    inner = jnp.asarray(np.hypot(info.x0[:, 0], info.x0[:, 1]) < 0.07, float)
 
     def out(b_inf, c1):
         new_law = dataclasses.replace(law, b_inf=b_inf)
         shear = dataclasses.replace(fab.shear, coeffs=c0.at[0].set(c1))
         m = forming.with_fabric(model, fab.replace(bending=(new_law, new_law), shear=shear))
         s, _ = forming.rollout(m, state, info)
-        z = s.x[:, 2] - 0.5 * h
-        return jnp.sum(ring * z) / jnp.sum(ring) * 1e3  # mm
+        u = (s.x - X) * 1e3  # mm
+        return jnp.stack([jnp.sum(inner * u[:, 2]) / jnp.sum(inner), jnp.mean(jnp.sum(u * u, axis=1))])
 
     b, c = float(law.b_inf), float(c0[0])
     f = jax.jit(out)
-    g = jax.jit(jax.grad(out, argnums=(0, 1)))(b, c)
+    y = np.asarray(f(b, c))
+    assert y[0] < -0.05  # the blank did move
+    jac = jax.jit(jax.jacrev(out, argnums=(0, 1)))(b, c)
     for i, (x, dx) in enumerate(((b, 1e-3 * b), (c, 1e-3 * c))):
-        args_p = [b, c]
-        args_m = [b, c]
-        args_p[i] = x + dx
-        args_m[i] = x - dx
-        fd = (float(f(*args_p)) - float(f(*args_m))) / (2 * dx)
-        assert np.isfinite(float(g[i]))
-        assert float(g[i]) == pytest.approx(fd, rel=1e-3, abs=1e-12 + 1e-3 * abs(fd))
+        args_p, args_m = [b, c], [b, c]
+        args_p[i], args_m[i] = x + dx, x - dx
+        fd = (np.asarray(f(*args_p)) - np.asarray(f(*args_m))) / (2 * dx)
+        g = np.asarray(jac[i])
+        assert np.all(np.abs(fd) > 0)
+        np.testing.assert_allclose(g, fd, rtol=1e-3)

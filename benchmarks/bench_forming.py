@@ -67,6 +67,14 @@ def _per_step(name, size_mm, n=100):
             "build_and_compile_s": t_compile, "full_stroke_estimate_s": t_compile + per * info.n_steps}
 
 
+def _log(name, value):
+    import json
+    import sys
+
+    print(f"[bench_forming] {name}: {json.dumps(value, default=float)}", file=sys.stderr, flush=True)
+    return value
+
+
 def run(quick: bool = False) -> dict:
     from jaxform import forming
 
@@ -75,29 +83,25 @@ def run(quick: bool = False) -> dict:
         r = forming.simulate(_case("case-a-woven-nlbm", 25.0, "process.stroke_mm=5", "process.frames=3"))
         out["quick_case_a"] = _figures(r)
         return out
-    # item 7: 2 mm per-step cost (full runs take hours on a loaded 2-core machine)
-    out["case_a_2mm"] = {b: _per_step(f"case-a-woven-{b}", 2.0) for b in ("nlbm", "lbm-41", "membrane")}
-    c2 = out["case_a_2mm"]
-    c2["nlbm_overhead_over_lbm"] = c2["nlbm"]["per_step_s"] / c2["lbm-41"]["per_step_s"] - 1.0
-    # item 7: the OpenRadioss comparison setup
-    r = forming.simulate(_case("case-a-woven-lbm-41", 4.0, "process.speed_mm_per_s=1000.0"))
-    out["openradioss_setup"] = _figures(r)
-    out["openradioss_setup"]["openradioss_s"] = {"1_core": 429.0, "2_cores": 277.0}
     # items 1, 2, 6 on the coarse mesh
     base = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM))
     out["coarse_nlbm"] = _figures(base)
+    _log("coarse_nlbm", out["coarse_nlbm"])
     slow = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM, "process.speed_mm_per_s=250.0"))
     out["coarse_nlbm_half_speed"] = _figures(slow)
+    _log("coarse_nlbm_half_speed", out["coarse_nlbm_half_speed"])
     g1, g2 = np.degrees(base.fields["shear_angle"][-1]), np.degrees(slow.fields["shear_angle"][-1])
     d1, d2 = base.summary["draw_in"]["edge_mid_m"], slow.summary["draw_in"]["edge_mid_m"]
     out["quasi_static"] = {"draw_in_change": abs(d1 - d2) / abs(d2), "shear_diff_p95_deg": float(np.percentile(
         np.abs(g1 - g2), 95)), "wall_time_ratio": slow.wall_time_s / base.wall_time_s}
+    _log("quasi_static", out["quasi_static"])
     jax.config.update("jax_enable_x64", True)
     try:
         r64 = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM, 'numerics.dtype="float64"'))
     finally:
         jax.config.update("jax_enable_x64", False)
     out["coarse_nlbm_float64"] = _figures(r64)
+    _log("coarse_nlbm_float64", out["coarse_nlbm_float64"])
     g64 = np.degrees(r64.fields["shear_angle"][-1])
     f32, f64 = out["coarse_nlbm"], out["coarse_nlbm_float64"]
     out["float32_vs_float64"] = {
@@ -107,8 +111,20 @@ def run(quick: bool = False) -> dict:
         "wrinkles": [f32["flange_wrinkles"], f64["flange_wrinkles"]],
         "wall_time_ratio": r64.wall_time_s / base.wall_time_s,
     }
+    _log("float32_vs_float64", out["float32_vs_float64"])
     ncf = forming.simulate(_case("case-a-ncf-nlbm", COARSE_MM))
     out["coarse_ncf_nlbm"] = _figures(ncf)
+    _log("coarse_ncf_nlbm", out["coarse_ncf_nlbm"])
+    # item 7: 2 mm per-step cost (full runs take hours on a loaded 2-core machine)
+    out["case_a_2mm"] = {b: _per_step(f"case-a-woven-{b}", 2.0) for b in ("nlbm", "lbm-41", "membrane")}
+    c2 = out["case_a_2mm"]
+    c2["nlbm_overhead_over_lbm"] = c2["nlbm"]["per_step_s"] / c2["lbm-41"]["per_step_s"] - 1.0
+    _log("case_a_2mm", c2)
+    # item 7: the OpenRadioss comparison setup
+    r = forming.simulate(_case("case-a-woven-lbm-41", 4.0, "process.speed_mm_per_s=1000.0"))
+    out["openradioss_setup"] = _figures(r)
+    out["openradioss_setup"]["openradioss_s"] = {"1_core": 429.0, "2_cores": 277.0}
+    _log("openradioss_setup", out["openradioss_setup"])
     return out
 
 

@@ -103,3 +103,16 @@ def test_failed_run_keeps_its_frames_and_says_why(tmp_out):
     assert len(frames) >= 1
     for _, name in frames:
         assert np.all(np.isfinite(meshio.read(tmp_out / name).points))
+
+
+def test_run_from_a_case_file(tmp_path, capsys):
+    from jaxform import cases
+    from jaxform.io.case_file import write_case
+
+    case = cases.apply_overrides(cases.load("case-a-woven-nlbm"), ["name=my-run", "blank.element_size_mm=25"])
+    path = write_case(case, tmp_path / "my.toml")
+    out = tmp_path / "out"
+    assert main(["run", str(path), "--out", str(out), "--set", "process.stroke_mm=4", "--set", "process.frames=2",
+                 "--quiet"]) == 0
+    s = json.loads((out / "summary.json").read_text())
+    assert s["case"] == "my-run" and s["complete"] is True

@@ -51,7 +51,7 @@ def test_orientations_rotate_the_fibres():
 
 
 def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N():
-    case = _coarse("case-b-woven-nlbm", size_mm=12.5, process__stroke_mm=6, process__frames=2)
+    case = _coarse("case-b-woven-nlbm", size_mm=25.0, process__stroke_mm=5, process__frames=2)
     r = forming.simulate(case, samples_per_frame=12)
     assert r.complete, r.reason
     h = case.ply_thickness

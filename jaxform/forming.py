@@ -622,6 +622,8 @@ def summarize(result: FormingResult) -> dict:
     late = h["t"] >= 0.2 * T if len(h["t"]) else np.zeros(0, bool)
     ratio = np.where(ie > 0, ke / np.maximum(ie, 1e-300), np.inf) if len(ie) else ie
     max_ke_ie = float(np.max(ratio[late])) if np.any(late) else None
+    if max_ke_ie is not None and not math.isfinite(max_ke_ie):
+        max_ke_ie = None  # no internal energy yet (JSON has no inf)
     gam = result.fields.get("shear_angle")
     max_shear = float(np.degrees(np.max(np.abs(gam)))) if gam is not None and gam.size else None
     di = draw_in(result.x[-1], info) if len(result.x) else None

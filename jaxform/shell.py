@@ -247,29 +247,8 @@ class Shell:
         return jnp.concatenate(out) * mass_scale
 
 
-def _horner_integral(law, a, twice: bool):
-    """``integral``/``integral2`` of a :class:`PolynomialShear` at ``a = |gamma|`` by Horner's rule.
-
-    Same values as the law's own methods (tested), without the array-exponent ``pow`` (a log and
-    an exp per term) that dominates the step time otherwise.
-    """
-    c = law.coeffs
-    n = int(np.shape(c)[-1])
-    acc = jnp.zeros_like(a)
-    for i in range(n, 0, -1):
-        k = c[..., i - 1] / ((i + 1) * (i + 2) if twice else (i + 1))
-        acc = acc * a + k
-    return acc * (a * a * a if twice else a * a)
-
-
 def _shear_energy(law, gamma, reading: str):
-    from jaxform.materials.shear import CompositeShear, PolynomialShear
-
-    if isinstance(law, CompositeShear):
-        return sum(_shear_energy(t, gamma, reading) for t in law.terms)
-    if isinstance(law, PolynomialShear):
-        a = jnp.where(gamma >= 0, gamma, -gamma)
-        return _horner_integral(law, a, twice=(reading == "a14"))
+    """Shear energy per reference area, J/m², of a reading (the laws evaluate by Horner's rule)."""
     return law.integral2(gamma) if reading == "a14" else law.integral(gamma)
 
 

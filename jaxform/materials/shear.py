@@ -58,33 +58,34 @@ class PolynomialShear:
     def degree(self) -> int:
         return int(np.shape(self.coeffs)[-1])
 
-    def _powers(self, a, offset: int):
-        # a^(i + offset) for i = 1..n, stacked on the last axis.
-        i = jnp.arange(1, self.degree + 1)
-        return a[..., None] ** (i + offset)
+    def _series(self, a, weight, shift: int):
+        """``sum_i weight(i) c_i a^(i + shift)`` for i = 1..n by Horner's rule (no pow: one multiply-add per term)."""
+        n = self.degree
+        acc = jnp.zeros_like(a)
+        for i in range(n, 0, -1):
+            acc = acc * a + weight(i) * self.coeffs[..., i - 1]
+        # acc = sum_i w_i c_i a^(i-1); multiply by a^(1 + shift)
+        return acc * a ** (1 + shift) if shift != -1 else acc
 
     def force(self, gamma):
         """Normalised shear force, N/m, for shear angle ``gamma`` (rad); any shape."""
         a, s = _split_sign(gamma)
-        return s * jnp.sum(self.coeffs * self._powers(a, 0), axis=-1)
+        return s * self._series(a, lambda i: 1.0, 0)
 
     def tangent(self, gamma):
         """``dF/dgamma``, N/m per rad (even in ``gamma``)."""
         a, _ = _split_sign(gamma)
-        i = jnp.arange(1, self.degree + 1)
-        return jnp.sum(self.coeffs * i * self._powers(a, -1), axis=-1)
+        return self._series(a, lambda i: float(i), -1)
 
     def integral(self, gamma):
         """``∫_0^gamma F dg``, J/m² (even in ``gamma``)."""
         a, _ = _split_sign(gamma)
-        i = jnp.arange(1, self.degree + 1)
-        return jnp.sum(self.coeffs / (i + 1) * self._powers(a, 1), axis=-1)
+        return self._series(a, lambda i: 1.0 / (i + 1), 1)
 
     def integral2(self, gamma):
         """``∫_0^|gamma| integral(g) dg``, J/m²·rad (even in ``gamma``)."""
         a, _ = _split_sign(gamma)
-        i = jnp.arange(1, self.degree + 1)
-        return jnp.sum(self.coeffs / ((i + 1) * (i + 2)) * self._powers(a, 2), axis=-1)
+        return self._series(a, lambda i: 1.0 / ((i + 1) * (i + 2)), 2)
 
 
 @pytree_dataclass

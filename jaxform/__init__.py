@@ -1,10 +1,56 @@
 """jaxform: differentiable explicit forming simulation of engineering fabrics in JAX.
 
 Public names only; see the README for a tour. SI units everywhere (``jaxform.units``).
+
+Modules along the data flow (imports point one way along it)::
+
+    units, materials          laws and presets (SI)
+    mesh, shell               the fabric shell: one kernel for every use
+    tools, contact            rigid tools, penalty contact with regularised Coulomb friction
+    model, integrate          fixed model / changing state, explicit central differences
+    cases, forming            hemisphere forming cases (TOML) and their runs
+    cantilever, frame_tests   lab tests built on the same shell (cantilever, picture frame, bias extension)
+    metrics                   wrinkle metric: tool distance, principal curvatures, zones
+    calibrate                 fitting laws to measurements through the model
+
+``jaxform.simulate(case)`` runs a forming case (``jaxform.cases.load(name_or_toml)``).
+Sub-modules are imported on first use, so ``import jaxform`` stays light.
 """
+from __future__ import annotations
+
+import importlib
+
 from jaxform import materials, units
 from jaxform.materials import NCF_FCIM359, WOVEN_38616, Fabric
 
 __version__ = "0.1.0"
 
-__all__ = ["materials", "units", "Fabric", "WOVEN_38616", "NCF_FCIM359", "__version__"]
+_MODULES = (
+    "mesh",
+    "shell",
+    "tools",
+    "contact",
+    "model",
+    "integrate",
+    "cases",
+    "forming",
+    "cantilever",
+    "frame_tests",
+    "metrics",
+    "calibrate",
+)
+
+
+def __getattr__(name: str):
+    if name in _MODULES:
+        return importlib.import_module(f"jaxform.{name}")
+    if name == "simulate":
+        return importlib.import_module("jaxform.forming").simulate
+    raise AttributeError(f"module 'jaxform' has no attribute {name!r}")
+
+
+def __dir__():
+    return sorted(list(globals()) + list(_MODULES) + ["simulate"])
+
+
+__all__ = ["materials", "units", "Fabric", "WOVEN_38616", "NCF_FCIM359", "simulate", "__version__", *_MODULES]

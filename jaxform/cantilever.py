@@ -107,7 +107,8 @@ def _hessian_colouring(mesh: Mesh, free_idx: np.ndarray):
         colour: (P,) the seed whose product holds entry (rows, cols).
     """
     n = mesh.n_nodes
-    groups = [list(t) for t in np.asarray(mesh.tris)] + [sorted(set(s)) for s in np.asarray(mesh.nbr)]
+    # A node's bending energy depends on its whole stencil AND on the node itself (u[nbr] - u[i]).
+    groups = [list(t) for t in np.asarray(mesh.tris)] + [sorted(set(s) | {i}) for i, s in enumerate(np.asarray(mesh.nbr))]
     adj = [set() for _ in range(n)]
     for grp in groups:
         for a in grp:

@@ -4,9 +4,9 @@ A strip of arc length ``overhang`` (m), width ``width`` and areal mass ``areal_m
 clamped horizontally at ``x = 0`` (ply normal up) and hangs under gravity (9.81 m/s²). The static
 equilibrium minimises ``E_shell(x) - sum_i m_i g . x_i`` over the free nodes. It is found by Newton's
 method on that energy (dense Hessian: the strip has a few hundred unknowns), with the gravity
-applied in ``load_steps`` increments, each followed by ``newton_iters`` Newton iterations
-(Levenberg-regularised by a tiny multiple of the Hessian's diagonal to pass the zero shear
-stiffness of the flat fabric). The clamp holds the first two rows of nodes (``x = -h`` and
+applied in ``load_steps`` increments with softened fibres, then ``stiffen_steps`` increments that
+restore the fibre modulus, all in one jitted ``lax.while_loop``; the Hessian is assembled from a
+few gradient JVPs by a distance-2 colouring of the strip. The clamp holds the first two rows (``x = -h`` and
 ``x = 0``): zero slope at the clamp edge.
 
 Gradients (``jax.grad`` w.r.t. the law's parameters, the fibre modulus, ...) use the implicit

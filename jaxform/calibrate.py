@@ -53,6 +53,7 @@ GRAVITY = 9.81  # m/s², SPEC section 6
 PEIRCE_ANGLE_DEG = 41.5
 DETERMINED_RATIO = 5.0  # B_inf is determined where the data reach this many kappa0
 _RES_SCALE = 1.0e-3  # residuals in mm inside the optimiser (conditioning only)
+_MAX_STEP = 1.5  # largest LM step in any unconstrained parameter (a factor e^1.5 in B_init, kappa0)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -511,6 +512,11 @@ def _levenberg_marquardt(res_and_jac, q0, max_iter, tol):
         accepted = False
         for _ in range(12):
             step = -np.linalg.solve(A + lam * dA, gvec)
+            # trust cap in q (log B_init, log kappa0, logit): a flat direction (b_inf -> 0 saturates
+            # the logit) otherwise takes steps of hundreds and wastes simulations
+            big = float(np.max(np.abs(step)))
+            if big > _MAX_STEP:
+                step *= _MAX_STEP / big
             q_new = q + step
             r_new, J_new = res_and_jac(q_new)
             cost_new = 0.5 * float(r_new @ r_new) if np.all(np.isfinite(r_new)) else np.inf

@@ -49,43 +49,43 @@ def test_build_tools_places_the_rig():
     assert float(a.holder.bottom_z) == pytest.approx(7e-3)
 
 
-def _bad(change, key_fragment):
+def _error_of(change) -> str:
+    """The message of the ValueError that validating a changed preset raises."""
     d = copy.deepcopy(cases.PRESETS["case-a-woven-nlbm"])
     change(d)
     with pytest.raises(ValueError) as err:
         cases.from_dict(d)
-    assert key_fragment in str(err.value), str(err.value)
     return str(err.value)
 
 
 def test_each_validation_error_names_its_key():
-    _bad(lambda d: d["tools"].update(punch_radus_mm=50.0), "'tools.punch_radus_mm'")
-    _bad(lambda d: d.update(colour="red"), "'colour'")
-    _bad(lambda d: d["blank"].pop("size_mm"), "'blank.size_mm'")
-    _bad(lambda d: d.pop("process"), "[process]")
-    _bad(lambda d: d["holder"].pop("gap_mm"), "'holder.gap_mm'")
-    _bad(lambda d: d["holder"].update(mode="force"), "'holder.force_N'")
-    _bad(lambda d: d["blank"].update(size_mm=100.0), "'blank.size_mm'")  # smaller than the opening
-    _bad(lambda d: d["holder"].update(gap_mm=0.2), "'holder.gap_mm'")  # gap smaller than the stack
-    _bad(lambda d: d["blank"].update(element_size_mm=0.0), "'blank.element_size_mm'")
-    _bad(lambda d: d["blank"].update(element_size_mm=-1.0), "'blank.element_size_mm'")
-    _bad(lambda d: d["tools"].update(punch_radius_mm=-5.0), "'tools.punch_radius_mm'")
-    _bad(lambda d: d["tools"].update(punch_radius_mm=53.0), "'tools.punch_radius_mm'")  # does not fit
-    _bad(lambda d: d["tools"].update(die_fillet_mm=12.0), "'tools.die_fillet_mm'")
-    _bad(lambda d: d["process"].update(stroke_mm="50"), "'process.stroke_mm'")
-    _bad(lambda d: d["process"].update(frames=1), "'process.frames'")
-    _bad(lambda d: d["process"].update(speed_mm_per_s=0.0), "'process.speed_mm_per_s'")
-    _bad(lambda d: d["fabric"].update(bending="cubic"), "'fabric.bending'")
-    _bad(lambda d: d["fabric"].update(preset="silk"), "'fabric.preset'")
-    _bad(lambda d: d["fabric"].update(voce={"b_inf_Nm": 1e-5, "m0_N": 1e-3}), "'fabric.voce.kappa0_per_m'")
-    _bad(lambda d: d["numerics"].update(dtype="float16"), "'numerics.dtype'")
-    _bad(lambda d: d["contact"].update(penalty_stiffness_Pa_per_m=-1.0), "'contact.penalty_stiffness_Pa_per_m'")
-    _bad(lambda d: d["plies"].update(orientations_deg=[]), "'plies.orientations_deg'")
+    assert "'tools.punch_radus_mm'" in _error_of(lambda d: d["tools"].update(punch_radus_mm=50.0))
+    assert "'colour'" in _error_of(lambda d: d.update(colour="red"))
+    assert "'blank.size_mm'" in _error_of(lambda d: d["blank"].pop("size_mm"))
+    assert "[process]" in _error_of(lambda d: d.pop("process"))
+    assert "'holder.gap_mm'" in _error_of(lambda d: d["holder"].pop("gap_mm"))
+    assert "'holder.force_N'" in _error_of(lambda d: d["holder"].update(mode="force"))
+    assert "'blank.size_mm'" in _error_of(lambda d: d["blank"].update(size_mm=100.0))  # smaller than the opening
+    assert "'holder.gap_mm'" in _error_of(lambda d: d["holder"].update(gap_mm=0.2))  # gap smaller than the stack
+    assert "'blank.element_size_mm'" in _error_of(lambda d: d["blank"].update(element_size_mm=0.0))
+    assert "'blank.element_size_mm'" in _error_of(lambda d: d["blank"].update(element_size_mm=-1.0))
+    assert "'tools.punch_radius_mm'" in _error_of(lambda d: d["tools"].update(punch_radius_mm=-5.0))
+    assert "'tools.punch_radius_mm'" in _error_of(lambda d: d["tools"].update(punch_radius_mm=53.0))  # does not fit
+    assert "'tools.die_fillet_mm'" in _error_of(lambda d: d["tools"].update(die_fillet_mm=12.0))
+    assert "'process.stroke_mm'" in _error_of(lambda d: d["process"].update(stroke_mm="50"))
+    assert "'process.frames'" in _error_of(lambda d: d["process"].update(frames=1))
+    assert "'process.speed_mm_per_s'" in _error_of(lambda d: d["process"].update(speed_mm_per_s=0.0))
+    assert "'fabric.bending'" in _error_of(lambda d: d["fabric"].update(bending="cubic"))
+    assert "'fabric.preset'" in _error_of(lambda d: d["fabric"].update(preset="silk"))
+    assert "'fabric.voce.kappa0_per_m'" in _error_of(lambda d: d["fabric"].update(voce={"b_inf_Nm": 1e-5, "m0_N": 1e-3}))
+    assert "'numerics.dtype'" in _error_of(lambda d: d["numerics"].update(dtype="float16"))
+    assert "'contact.penalty_stiffness_Pa_per_m'" in _error_of(lambda d: d["contact"].update(penalty_stiffness_Pa_per_m=-1.0))
+    assert "'plies.orientations_deg'" in _error_of(lambda d: d["plies"].update(orientations_deg=[]))
     # Eight plies of 0.3 mm do not fit a 2 mm gap.
     def thick(d):
         d["plies"]["orientations_deg"] = [0.0] * 8
         d["holder"]["gap_mm"] = 2.0
-    _bad(thick, "'holder.gap_mm'")
+    assert "'holder.gap_mm'" in _error_of(thick)
 
 
 def test_overrides():

@@ -22,6 +22,17 @@ def _figure():
     return fig
 
 
+def _finish_map(fig, ax, title: str, path) -> pathlib.Path:
+    """Label a top-view map (x, y in mm), write it as PNG and return the path."""
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (mm)")
+    ax.set_ylabel("y (mm)")
+    ax.set_title(title)
+    path = pathlib.Path(path)
+    fig.savefig(path)
+    return path
+
+
 def plot_node_field(path, nodes, faces, values, *, title: str, label: str, scale: float = 1.0,
                     cmap: str = "viridis", vmin=None, vmax=None) -> pathlib.Path:
     """Top view (x, y in mm) of a nodal field, Gouraud-shaded. ``scale`` multiplies the values
@@ -36,13 +47,7 @@ def plot_node_field(path, nodes, faces, values, *, title: str, label: str, scale
         art = ax.tripcolor(x[:, 0], x[:, 1], _triangles(faces), v, shading="gouraud", cmap=cmap,
                            vmin=vmin, vmax=vmax)
     fig.colorbar(art, ax=ax, label=label)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.set_title(title)
-    path = pathlib.Path(path)
-    fig.savefig(path)
-    return path
+    return _finish_map(fig, ax, title, path)
 
 
 def plot_zones(path, nodes, faces, labels, *, title: str = "Zones") -> pathlib.Path:
@@ -61,13 +66,7 @@ def plot_zones(path, nodes, faces, labels, *, title: str = "Zones") -> pathlib.P
                  vmin=-0.5, vmax=2.5)
     ax.legend(handles=[Patch(color=c, label=n) for c, n in
                        zip(colors, ("conforming", "bridging", "wrinkle"))], loc="upper right")
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (mm)")
-    ax.set_ylabel("y (mm)")
-    ax.set_title(title)
-    path = pathlib.Path(path)
-    fig.savefig(path)
-    return path
+    return _finish_map(fig, ax, title, path)
 
 
 def plot_density(path, density, edges, *, title: str, label: str, scale: float = 1.0) -> pathlib.Path:

@@ -30,7 +30,7 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass
 from jaxform.model import Energies, Hold, Model, State
-from jaxform.shell import Shell, forces_and_energy, stable_time_step
+from jaxform.shell import Shell, forces_and_energy, forces_and_energy_soa, stable_time_step
 
 
 class SimulationError(RuntimeError):
@@ -118,39 +118,43 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
     z = jnp.zeros((), dtype)
     e = Energies(ke, parts["tension"], parts["shear"], parts["bending"], z, z, z, z)
     loads = tuple(None for _ in model.loads) if load_states is None else tuple(load_states)
-    zero = jnp.zeros_like(x)
+    zero = jnp.zeros_like(x.T)  # SoA (3, N), as the step keeps them
     return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
                  f_prev=(zero, zero, zero), bad_step=jnp.asarray(-1, jnp.int32),
                  bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale())
 
 
 def _step(model: Model, state: State, x_ref, blowup_tol):
+    # The arithmetic runs on structure-of-arrays vectors (3, N) (contiguous rows vectorise on CPU;
+    # (N, 3) with its 3-long trailing axis does not); the state and the load interface stay (N, 3).
     dt = model.dt
-    m = model.mass[:, None]
+    m = model.mass[None, :]
     x, v_old, t = state.x, state.v, state.t
+    xs, vs_old = x.T, v_old.T
     first = state.step == 0
-    f_int, parts = forces_and_energy(x, model.shell)
-    f_grav = m * model.gravity
-    f_damp = -model.damping * m * v_old
-    f_loads = jnp.zeros_like(x)
+    f_int, parts = forces_and_energy_soa(xs, model.shell)
+    f_grav = m * model.gravity[:, None]
+    f_damp = -model.damping * m * vs_old
+    f_loads = jnp.zeros_like(xs)
     new_loads, extras = [], []
     for load, ls in zip(model.loads, state.loads):
         f, ls_new, ex = load.force(x, v_old, t, ls)
-        f_loads = f_loads + f
+        f_loads = f_loads + f.T
         new_loads.append(ls_new)
         extras.append(ex)
     f_free = f_int + f_grav + f_damp + f_loads
     # on the first step the initial velocity is the full-step velocity: advance half a step
     h = jnp.where(first, 0.5 * dt, dt)
-    v_free = v_old + h * f_free / m
-    x_drive = model.drive.position(t + dt)
-    v_drive = (x_drive - x) / dt
-    v_new = jnp.where(model.fixed, v_drive, v_free)
-    x_new = x + dt * v_new
-    reaction = jnp.where(model.fixed, m * (v_new - v_old) / h - f_free, 0.0)
+    v_free = vs_old + h * f_free / m
+    fixed = model.fixed.T
+    x_drive = model.drive.position(t + dt).T
+    v_drive = (x_drive - xs) / dt
+    v_new = jnp.where(fixed, v_drive, v_free)
+    x_new = xs + dt * v_new
+    reaction = jnp.where(fixed, m * (v_new - vs_old) / h - f_free, 0.0)
     # energies at step n: kinetic with the mid velocity, work by the trapezoidal rule over x_{n-1} -> x_n
-    v_mid = jnp.where(first, v_old, 0.5 * (v_old + v_new))
-    dx = jnp.where(first, 0.0, dt * v_old)
+    v_mid = jnp.where(first, vs_old, 0.5 * (vs_old + v_new))
+    dx = jnp.where(first, 0.0, dt * vs_old)
     fl0, fd0, fr0 = state.f_prev
     e_old = state.energies
     e = Energies(
@@ -158,39 +162,68 @@ def _step(model: Model, state: State, x_ref, blowup_tol):
         tension=parts["tension"],
         shear=parts["shear"],
         bending=parts["bending"],
-        gravity_work=jnp.sum(f_grav * (x - x_ref)),
+        gravity_work=jnp.sum(f_grav * (xs - x_ref.T)),
         external_work=e_old.external_work + 0.5 * jnp.sum((fl0 + f_loads) * dx),
         boundary_work=e_old.boundary_work + 0.5 * jnp.sum((fr0 + reaction) * dx),
         damping_work=e_old.damping_work - 0.5 * jnp.sum((fd0 + f_damp) * dx),
     )
-    return x_new, v_new, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction)
+    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction)
 
 
 def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
     """Advance one time step (pure). A failed run stays frozen at its last good state."""
     x_ref = model.drive.position(0.0) if x_ref is None else x_ref
     e0 = state.energies if e0 is None else e0
-    x_new, v_new, e, loads, _, fp = _step(model, state, x_ref, blowup_tol)
-    return _guard(model, state, x_new, v_new, e, loads, fp, e0, blowup_tol)
+    new, _ = _advance(model, state, x_ref, e0, blowup_tol)
+    return _freeze_if_failed(state, new)
 
 
-def _guard(model, state, x_new, v_new, e, loads, f_prev, e0, blowup_tol):
-    finite = jnp.all(jnp.isfinite(x_new)) & jnp.all(jnp.isfinite(v_new)) & jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic)
+def _advance(model, state, x_ref, e0, blowup_tol):
+    """One step and its health check, without freezing: ``(new_state, extras)``.
+
+    ``bad_step``/``bad_code`` record the first failing step; the arrays go on (the caller
+    reverts a failed stretch to its start, :func:`_freeze_if_failed`): a per-step select of the
+    whole state costs as much as the forces on CPU (it defeats XLA's in-place buffer reuse).
+    """
+    x_new, v_new, e, loads, extras, fp = _step(model, state, x_ref, blowup_tol)
+    # every node's position and velocity enters the energies: one non-finite value makes them so
+    finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
     tiny = 1e-30 if x_new.dtype == jnp.float64 else 1e-20
     blown = jnp.abs(e.balance(e0)) > blowup_tol * scale + tiny
     code = jnp.where(~finite, 1, jnp.where(blown, 2, 0)).astype(jnp.int32)
-    healthy = state.bad_step < 0
-    fail_now = healthy & (code > 0)
-    keep = ~healthy | fail_now
+    fail_now = (state.bad_step < 0) & (code > 0)
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
-                f_prev=f_prev, bad_step=jnp.where(fail_now, state.step, state.bad_step),
+                f_prev=fp, bad_step=jnp.where(fail_now, state.step, state.bad_step),
                 bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max))
-    frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), state, new)
-    # bookkeeping fields always advance
-    return State(x=frozen.x, v=frozen.v, t=frozen.t, step=state.step + 1, energies=frozen.energies,
-                 loads=frozen.loads, f_prev=frozen.f_prev, bad_step=new.bad_step, bad_code=new.bad_code,
+    return new, extras
+
+
+def _freeze_if_failed(start: State, end: State) -> State:
+    """``end`` if the stretch ``start -> end`` stayed healthy, else ``start`` (the last good state)
+    with ``end``'s step count and failure record."""
+    keep = (start.bad_step < 0) & (end.bad_step >= 0) | (start.bad_step >= 0)
+    frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), start, end)
+    return State(x=frozen.x, v=frozen.v, t=frozen.t, step=end.step, energies=frozen.energies,
+                 loads=frozen.loads, f_prev=frozen.f_prev, bad_step=end.bad_step, bad_code=end.bad_code,
                  scale_max=frozen.scale_max)
+
+
+def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None, x_ref=None,
+              blowup_tol: float = 0.5):
+    """``n`` steps (``lax.scan``; pure, jit-able, differentiable): ``(state, extras of the last step)``.
+
+    A stretch in which a step fails returns its starting state (the last good one) with the
+    failing step recorded in ``bad_step``/``bad_code``.
+    """
+    x_ref = model.drive.position(0.0) if x_ref is None else x_ref
+    e0 = state.energies if e0 is None else e0
+
+    def one(s, _):
+        return _advance(model, s, x_ref, e0, blowup_tol)
+
+    end, extras = jax.lax.scan(one, state, None, length=n)
+    return _freeze_if_failed(state, end), jax.tree_util.tree_map(lambda a: a[-1], extras)
 
 
 def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint: bool = True,
@@ -199,17 +232,13 @@ def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint
 
     Each chunk of ``every`` steps is a ``lax.scan`` wrapped in ``jax.checkpoint`` (when
     ``checkpoint``), so reverse mode stores one state per frame and recomputes inside chunks.
+    A failed run is frozen at the last good frame (the start of the chunk in which it failed).
     """
     e0 = state.energies
     x_ref = state.x
 
-    def one(s, _):
-        x_new, v_new, e, loads, extras, fp = _step(model, s, x_ref, blowup_tol)
-        return _guard(model, s, x_new, v_new, e, loads, fp, e0, blowup_tol), extras
-
     def chunk(s):
-        s, extras = jax.lax.scan(one, s, None, length=every)
-        return s, jax.tree_util.tree_map(lambda a: a[-1], extras)
+        return run_steps(model, s, every, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol)
 
     if checkpoint:
         chunk = jax.checkpoint(chunk)
@@ -258,4 +287,4 @@ def simulate(model: Model, state: State | None = None, *, n_frames: int, every: 
     return s, frames
 
 
-__all__ = ["make_model", "init_state", "step", "rollout", "simulate", "check", "Frames", "SimulationError"]
+__all__ = ["make_model", "init_state", "step", "run_steps", "rollout", "simulate", "check", "Frames", "SimulationError"]

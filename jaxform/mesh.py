@@ -9,11 +9,14 @@ geometry that does not depend on the material is precomputed here:
 * ``node_area`` (N,): lumped reference area of each node (a third of each adjacent triangle), m².
   Lumped masses are ``areal_mass * node_area``; bending is integrated with these weights.
 * ``nbr`` (N, K) and ``gfd`` (N, 5, K): for every node a padded neighbourhood (padding repeats the
-  node itself with zero weight) and least-squares "generalised finite-difference" weights such
+  node itself with zero weight; the node itself, whose weight is always zero, is left out) and
+  least-squares "generalised finite-difference" weights such
   that, for a field ``u`` on the nodes, ``sum_k gfd[i, m, k] * (u[nbr[i, k]] - u[i])`` estimates
   ``(du/dX, du/dY, d2u/dX2, d2u/dXdY, d2u/dY2)`` at node ``i`` in the node's local reference
   frame (``frame[i]``: rows ``t1, t2, n``). On a structured grid's interior the neighbourhood is
-  the 3x3 patch and the weights are (row-averaged) central differences.
+  the 3x3 patch and the weights are (row-averaged) central differences. Both are *stored*
+  neighbour-major, ``nbr_k`` (K, N) and ``gfd_k`` (K, 5, N), the layout the kernels stream
+  through (one contiguous row per neighbour slot); ``nbr``/``gfd`` are views in node-major order.
 * ``frame`` (N, 3, 3) and ``tri_frame`` (T, 3, 3): local reference frames. ``t1`` is the global x
   axis projected on the tangent plane (the y axis where x is normal to the surface); ``n`` points
   to the ply's top face (``+z`` for a flat blank meshed counter-clockwise seen from above).
@@ -40,8 +43,9 @@ class Mesh:
         nodes: (N, 3) reference node positions, m.
         tris: (T, 3) int32 triangle corners (counter-clockwise about the ply normal).
         node_area: (N,) lumped reference area per node, m².
-        nbr: (N, K) int32 padded neighbourhood of each node (itself as padding).
-        gfd: (N, 5, K) finite-difference weights for d/dX, d/dY, d2/dX2, d2/dXdY, d2/dY2 (1/m, 1/m²).
+        nbr_k: (K, N) int32 padded neighbourhood of each node (itself as padding), neighbour-major.
+        gfd_k: (K, 5, N) finite-difference weights for d/dX, d/dY, d2/dX2, d2/dXdY, d2/dY2 (1/m,
+            1/m²), neighbour-major (see :attr:`nbr` and :attr:`gfd` for node-major views).
         frame: (N, 3, 3) local reference frame per node, rows (t1, t2, n).
         tri_frame: (T, 3, 3) local reference frame per triangle, rows (t1, t2, n).
         ply_nodes: static tuple of (start, stop) node ranges, one per ply.
@@ -53,14 +57,24 @@ class Mesh:
     nodes: Any
     tris: Any
     node_area: Any
-    nbr: Any
-    gfd: Any
+    nbr_k: Any
+    gfd_k: Any
     frame: Any
     tri_frame: Any
     ply_nodes: tuple = static_field(default=((0, 0),))
     ply_tris: tuple = static_field(default=((0, 0),))
     quads: bool = static_field(default=False)
     shape: tuple | None = static_field(default=None)
+
+    @property
+    def nbr(self):
+        """(N, K) neighbourhood table, node-major view of ``nbr_k``."""
+        return self.nbr_k.T
+
+    @property
+    def gfd(self):
+        """(N, 5, K) finite-difference weights, node-major view of ``gfd_k``."""
+        return self.gfd_k.transpose(2, 1, 0)
 
     @property
     def n_nodes(self) -> int:
@@ -278,6 +292,21 @@ def _gfd_weights(nodes, frames, neigh, hloc):
     return nbr, w
 
 
+def _drop_self(nbr, w, K: int | None = None):
+    """Remove the zero-weight entries that point at the node itself (they contribute nothing).
+
+    Kept entries stay in order at the front of each row; rows are cut to the longest kept row
+    (or to ``K``), the rest padded with the node itself at zero weight.
+    """
+    n = len(nbr)
+    own = (nbr == np.arange(n)[:, None]) & np.all(w == 0.0, axis=1)
+    order = np.argsort(own, axis=1, kind="stable")
+    nbr = np.take_along_axis(nbr, order, axis=1)
+    w = np.take_along_axis(w, order[:, None, :], axis=2)
+    K = int((~own).sum(axis=1).max()) if K is None else K
+    return nbr[:, :K], w[:, :, :K]
+
+
 def _build(parts, *, quads: bool, shape) -> Mesh:
     all_nodes, all_tris, ply_nodes, ply_tris = [], [], [], []
     all_area, all_frames, all_tframes, all_nbr, all_w = [], [], [], [], []
@@ -305,10 +334,11 @@ def _build(parts, *, quads: bool, shape) -> Mesh:
         else:
             neigh, hloc = _neighbourhoods(nodes, tris, frames)
             nbr, w = _gfd_weights(nodes, frames, neigh, hloc)
-        K = max(K, nbr.shape[1])
+        K = max(K, _drop_self(nbr, w)[0].shape[1])
         per.append((nodes, tris, node_area, frames, tframes, nbr, w))
     for nodes, tris, node_area, frames, tframes, nbr, w in per:
         n, t = len(nodes), len(tris)
+        nbr, w = _drop_self(nbr, w, K)
         pad = K - nbr.shape[1]
         if pad:
             nbr = np.concatenate([nbr, np.tile(np.arange(n)[:, None], (1, pad))], axis=1)
@@ -328,8 +358,8 @@ def _build(parts, *, quads: bool, shape) -> Mesh:
         nodes=np.concatenate(all_nodes),
         tris=np.concatenate(all_tris).astype(np.int32),
         node_area=np.concatenate(all_area),
-        nbr=np.concatenate(all_nbr).astype(np.int32),
-        gfd=np.concatenate(all_w),
+        nbr_k=np.ascontiguousarray(np.concatenate(all_nbr).astype(np.int32).T),
+        gfd_k=np.ascontiguousarray(np.concatenate(all_w).transpose(2, 1, 0)),
         frame=np.concatenate(all_frames),
         tri_frame=np.concatenate(all_tframes),
         ply_nodes=tuple(ply_nodes),

@@ -134,8 +134,8 @@ class State:
         step: step count (int).
         energies: :class:`Energies` at the current step.
         loads: tuple of load states (same order as ``Model.loads``).
-        f_prev: ((N, 3),)*3 load, damping and reaction forces of the previous step, N (work
-            accounts by the trapezoidal rule).
+        f_prev: ((3, N),)*3 load, damping and reaction forces of the previous step, N, in
+            structure-of-arrays layout (work accounts by the trapezoidal rule).
         bad_step: -1 while the run is healthy, else the first step that failed (run is frozen).
         bad_code: 0 ok, 1 non-finite values, 2 energy blow-up.
     """

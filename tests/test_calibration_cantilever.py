@@ -48,6 +48,10 @@ def test_round_trip(case, source):
         profiles.append(_sample(x, z, L, rng))
     fit = C.fit_cantilever(profiles, areal_mass=mass, compute_b41_5=False)
     b_init = params["b_inf"] + params["m0"] / params["kappa0"]
+    print(f"\n{case}/{source}: B_init {100 * (fit.b_init / b_init - 1):+.2f} %, B_inf "
+          f"{100 * (fit.b_inf / params['b_inf'] - 1):+.2f} %, kappa_max/kappa0 {fit.kappa_max_over_kappa0:.1f}, "
+          f"determined {fit.b_inf_determined}, rmse {1e3 * fit.rmse:.4f} mm, {fit.iterations} iterations, "
+          f"{fit.wall_time:.0f} s")
     assert fit.b_init == pytest.approx(b_init, rel=0.03)
     assert fit.b_init == pytest.approx(fit.b_inf + fit.m0 / fit.kappa0, rel=1e-12)
     assert np.all(np.isfinite([fit.b_inf, fit.m0, fit.kappa0]))
@@ -58,17 +62,26 @@ def test_round_trip(case, source):
 
 
 def test_standard_test_with_paper_laws_report():
-    """B_41.5 simulated with the paper's NLBM laws vs Table 1 (printed; only sanity is asserted)."""
+    """B_41.5 simulated with the paper's NLBM laws vs the elastica and Table 1 (all rows printed,
+    then asserted: the shell within 3 % of the independent elastica, every solve converged; Table 1
+    is reported, not asserted)."""
     rows = []
     for name, law, mass, table in (
         ("woven", WOVEN_38616.bending[0], 0.21, TABLE1_LBM["woven-38616"]["41.5"][0]),
         ("ncf pos", NCF_FCIM359.bending[0].pos, 0.44, TABLE1_LBM["ncf-fcim359"]["41.5"][0]),
         ("ncf neg", NCF_FCIM359.bending[0].neg, 0.44, TABLE1_LBM["ncf-fcim359"]["41.5"][1]),
     ):
-        shell = float(cantilever.standard_test(law, areal_mass=mass).b_41_5)
+        try:
+            st = cantilever.standard_test(law, areal_mass=mass)
+            shell, res = float(st.b_41_5), float(st.max_residual)
+        except cantilever.CantileverNotConverged as err:  # reported with the other rows, then failed
+            shell, res = float("nan"), float("inf")
+            print(f"\n{name}: {err}")
         ref = E.standard_test_b(E.peirce_overhang(E.voce_moment(float(law.b_inf), float(law.m0), float(law.kappa0)), mass), mass)
-        rows.append((name, shell, ref, table))
-        assert shell == pytest.approx(ref, rel=0.03)  # our shell against the independent elastica
-    print("\nB_41.5 (N·m): name, shell, reference elastica, Table 1")
+        rows.append((name, shell, ref, 100 * (shell / ref - 1), table, res))
+    print("\nB_41.5 (N·m): name, shell, reference elastica, shell vs elastica, Table 1, solver residual")
     for r in rows:
-        print("  %-8s %.3e %.3e %.1e" % r)
+        print("  %-8s %.4e %.4e %+.2f %% %.1e %.1e" % r)
+    for name, shell, ref, _, _, res in rows:
+        assert res <= 1e-5, name
+        assert shell == pytest.approx(ref, rel=0.03), name  # our shell against the independent elastica

@@ -172,7 +172,9 @@ def _derivs_soa(xs, mesh: Mesh):
     d = xs[:, mesh.nbr_k] - xs[:, None, :]  # (3, K, N)
     w = mesh.gfd_k.astype(xs.dtype)  # (K, 5, N)
     K = w.shape[0]
-    D = jnp.stack([sum(w[k, m][None] * d[:, k] for k in range(K)) for m in range(5)])
+    # slice once per operand: each slice's transpose (reverse mode) is a full-size pad
+    ds = [d[:, k] for k in range(K)]
+    D = jnp.stack([sum(w[k, m][None] * ds[k] for k in range(K)) for m in range(5)])
     return jax.lax.optimization_barrier(D)
 
 
@@ -180,7 +182,8 @@ def _derivs_transpose(G, mesh: Mesh):
     """(3, K, N): the transpose of :func:`_derivs_soa`: ``dE/d(x[nbr_k] - x)`` from ``G = dE/dD`` (5, 3, N)."""
     w = mesh.gfd_k.astype(G.dtype)
     K = w.shape[0]
-    return jnp.stack([sum(w[k, m][None] * G[m] for m in range(5)) for k in range(K)], axis=1)
+    Gs = [G[m] for m in range(5)]  # sliced once (see _derivs_soa)
+    return jnp.stack([sum(w[k, m][None] * Gs[m] for m in range(5)) for k in range(K)], axis=1)
 
 
 def node_derivatives(x, mesh: Mesh):

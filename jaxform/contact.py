@@ -152,33 +152,8 @@ def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
     return force, pressure, g, area * params.stiffness * e, -jnp.dot(f_t, v_t)
 
 
-def _contact_soa(phi, nx, ny, nz, vx, vy, vz, offset, area, params: ContactParams):
-    """:func:`node_contact` for all nodes at once, coordinates as separate (N,) arrays.
-
-    Returns ``(fx, fy, fz, pressure, gap, energy, friction_power)``, each (N,).
-    """
-    g = phi - offset
-    delta, e = penetration(g, params.smooth_width)
-    in_contact = delta > 0
-    v_n = vx * nx + vy * ny + vz * nz
-    p_elastic = params.stiffness * delta
-    p_damp = jnp.where(in_contact, -params.damping * v_n, 0.0)
-    pressure = jnp.maximum(p_elastic + p_damp, 0.0)
-    f_n = pressure * area
-    tx, ty, tz = vx - v_n * nx, vy - v_n * ny, vz - v_n * nz
-    eps = params.slip_velocity
-    coef = -params.friction * f_n * jax.lax.rsqrt(tx * tx + ty * ty + tz * tz + eps * eps)
-    fx, fy, fz = f_n * nx + coef * tx, f_n * ny + coef * ty, f_n * nz + coef * tz
-    pw = -coef * (tx * tx + ty * ty + tz * tz)
-    return fx, fy, fz, pressure, g, area * params.stiffness * e, pw
-
-
 def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_velocity, active=None) -> ContactResult:
     """Contact of all fabric nodes with one rigid tool.
-
-    Evaluated as structure of arrays (x, y, z columns; the analytic tools' closed-form distance
-    and normal, :func:`jaxform.tools.sdf_soa`), so XLA fuses it into a few loops over the nodes;
-    the same law as :func:`node_contact` per node.
 
     Args:
         tool: a tool pytree (:mod:`jaxform.tools`).
@@ -196,23 +171,17 @@ def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_ve
         :class:`ContactResult`.
     """
     x = jnp.asarray(x)
-    v = jnp.asarray(v)
     n = x.shape[0]
-    dt_ = x.dtype
-    phi, nx, ny, nz = tools.sdf_soa(tool, x[:, 0], x[:, 1], x[:, 2], dz)
-    offset = jnp.broadcast_to(jnp.asarray(offset, dt_), (n,))
-    area = jnp.broadcast_to(jnp.asarray(area, dt_), (n,))
+    phi, normal = tools.sdf(tool, x, dz)
+    offset = jnp.broadcast_to(jnp.asarray(offset, x.dtype), (n,))
+    area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (n,))
+    v_rel = jnp.asarray(v) - jnp.asarray(tool_velocity, x.dtype)
+    f, p, g, e, pw = jax.vmap(node_contact, in_axes=(0, 0, 0, 0, 0, None))(phi, normal, v_rel, offset, area, params)
     if active is not None:
-        area = area * jnp.asarray(active, dt_)
-    tv = jnp.asarray(tool_velocity, dt_)
-    fx, fy, fz, p, g, e, pw = _contact_soa(phi, nx, ny, nz, v[:, 0] - tv[0], v[:, 1] - tv[1], v[:, 2] - tv[2],
-                                           offset, area, params)
-    if active is not None:
-        a = jnp.asarray(active, dt_)
-        p, e = p * a, e * a
-    f = jnp.stack([fx, fy, fz], axis=1)
-    reaction = -jnp.stack([jnp.sum(fx), jnp.sum(fy), jnp.sum(fz)])
-    return ContactResult(force=f, reaction=reaction, pressure=p, gap=g, energy=jnp.sum(e), friction_power=jnp.sum(pw))
+        a = jnp.asarray(active, x.dtype)
+        f, p, e, pw = f * a[:, None], p * a, e * a, pw * a
+    return ContactResult(force=f, reaction=-jnp.sum(f, axis=0), pressure=p, gap=g, energy=jnp.sum(e),
+                         friction_power=jnp.sum(pw))
 
 
 def tool_pose(tool, t):

@@ -161,50 +161,6 @@ def _rounded_halfstrip(r, z, r_in, z_lo, z_hi, radius):
     return outside + inside - radius
 
 
-
-# ---------------------------------------------------------------------------------------------
-# Closed-form distance and normal, structure of arrays (the hot path of the forming contact)
-# ---------------------------------------------------------------------------------------------
-#
-# ``phi_normal_soa(x, y, z) -> (phi, nx, ny, nz)`` takes the coordinates as separate (N,) arrays
-# and returns the distance and the outward unit normal the same way: the analytic gradient, so no
-# per-point autodiff and no (N, 3) gathers; XLA fuses each into one loop over the nodes. Equal
-# (to rounding) to ``value_and_grad(phi_local)`` where that is differentiable; at degenerate
-# points (on the axis) the normal is ``+z`` like :func:`safe_normalize`'s fallback.
-
-
-def _safe_sqrt(s):
-    ok = s > 0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, s, 1.0)), 0.0), ok
-
-
-def _unit3(gx, gy, gz, tiny=1e-30):
-    s = gx * gx + gy * gy + gz * gz
-    ok = s > tiny
-    inv = jnp.where(ok, jax.lax.rsqrt(jnp.where(ok, s, 1.0)), 0.0)
-    return gx * inv, gy * inv, jnp.where(ok, gz * inv, 1.0)
-
-
-def _halfstrip_soa(x, y, z, r_in, z_lo, z_hi, radius):
-    """Rounded half-strip (see :func:`_rounded_halfstrip`) with its analytic normal, SoA."""
-    r, r_ok = _safe_sqrt(x * x + y * y)
-    zc = 0.5 * (z_lo + z_hi)
-    half = 0.5 * (z_hi - z_lo) - radius
-    dx = (r_in + radius) - r
-    sz = jnp.where(z - zc >= 0, 1.0, -1.0)
-    dz = sz * (z - zc) - half
-    ox, oz = jnp.maximum(dx, 0.0), jnp.maximum(dz, 0.0)
-    o, out = _safe_sqrt(ox * ox + oz * oz)
-    inside = jnp.minimum(jnp.maximum(dx, dz), 0.0)
-    phi = o + inside - radius
-    inv_o = jnp.where(out, 1.0 / jnp.where(out, o, 1.0), 0.0)
-    side = dx > dz
-    g_r = jnp.where(out, -ox * inv_o, jnp.where(side, -1.0, 0.0))  # d phi / d r
-    g_z = jnp.where(out, sz * oz * inv_o, jnp.where(side, 0.0, sz))  # d phi / d z
-    inv_r = jnp.where(r_ok, 1.0 / jnp.where(r_ok, r, 1.0), 0.0)
-    nx, ny, nz = _unit3(g_r * x * inv_r, g_r * y * inv_r, g_z)
-    return phi, nx, ny, nz
-
 @pytree_dataclass
 class Punch:
     """Hemispherical punch, apex down, on a cylindrical shank of the same radius going up (to +inf).
@@ -233,17 +189,6 @@ class Punch:
         sphere = safe_norm(d) - self.radius
         shank = _radial(p) - self.radius
         return jnp.where(d[2] >= 0, shank, sphere)
-
-    def phi_normal_soa(self, x, y, z):
-        """``(phi, nx, ny, nz)`` of points given as (N,) coordinate arrays (closed form)."""
-        dz = z - (self.apex_z + self.radius)
-        r2 = x * x + y * y
-        shank = dz >= 0
-        s2 = jnp.where(shank, r2, r2 + dz * dz)
-        d, _ = _safe_sqrt(s2)
-        phi = d - self.radius
-        nx, ny, nz = _unit3(x, y, jnp.where(shank, 0.0, dz))
-        return phi, nx, ny, nz
 
 
 @pytree_dataclass
@@ -281,11 +226,6 @@ class Die:
             _radial(p), p[2], self.opening_radius, self.top_z - self.thickness, self.top_z, self.fillet_radius
         )
 
-    def phi_normal_soa(self, x, y, z):
-        """``(phi, nx, ny, nz)`` of points given as (N,) coordinate arrays (closed form)."""
-        return _halfstrip_soa(x, y, z, self.opening_radius, self.top_z - self.thickness, self.top_z,
-                              self.fillet_radius)
-
 
 @pytree_dataclass
 class BlankHolder:
@@ -320,11 +260,6 @@ class BlankHolder:
         return _rounded_halfstrip(
             _radial(p), p[2], self.opening_radius, self.bottom_z, self.bottom_z + self.thickness, self.edge_radius
         )
-
-    def phi_normal_soa(self, x, y, z):
-        """``(phi, nx, ny, nz)`` of points given as (N,) coordinate arrays (closed form)."""
-        return _halfstrip_soa(x, y, z, self.opening_radius, self.bottom_z, self.bottom_z + self.thickness,
-                              self.edge_radius)
 
 
 def _check_plate(owner, opening, radius, thickness, radius_name):
@@ -479,22 +414,8 @@ def sdf(tool, points, dz=0.0):
         unit normal (finite everywhere; ``+z`` at degenerate points).
     """
     points = jnp.asarray(points)
-    if hasattr(tool, "phi_normal_soa"):
-        phi, nx, ny, nz = sdf_soa(tool, points[:, 0], points[:, 1], points[:, 2], dz)
-        return phi, jnp.stack([nx, ny, nz], axis=1)
     shift = jnp.zeros(3, points.dtype).at[2].set(jnp.asarray(dz, points.dtype))
     return jax.vmap(lambda p: _phi_normal_one(tool, p - shift))(points)
-
-
-def sdf_soa(tool, x, y, z, dz=0.0):
-    """:func:`sdf` with the points and the normal as separate (N,) coordinate arrays:
-    ``(phi, nx, ny, nz)``. Closed form for the analytic tools (``phi_normal_soa``); other tools go
-    through :func:`sdf`."""
-    dz = jnp.asarray(dz, x.dtype)
-    if hasattr(tool, "phi_normal_soa"):
-        return tool.phi_normal_soa(x, y, z - dz)
-    phi, n = sdf(tool, jnp.stack([x, y, z], axis=1), dz)
-    return phi, n[:, 0], n[:, 1], n[:, 2]
 
 
 def displacement(tool, t):
@@ -585,7 +506,6 @@ __all__ = [
     "GridSDF",
     "FormingTools",
     "sdf",
-    "sdf_soa",
     "displacement",
     "velocity",
     "safe_norm",

@@ -8,6 +8,8 @@
   wrinkles; 429 s on one core, 277 s on two).
 * ``case_a_2mm``: per-step time of woven Case A at 2 mm (NLBM, LBM, membrane) after compilation,
   and the full-stroke wall time it implies (steps x per-step + compile); NLBM's overhead over LBM.
+* ``step_split_ms``: ms per step of woven Case A at 4 and 2 mm split into shell forces, tool
+  contact and the rest (integrator, energies).
 * ``quasi_static``: the same coarse run at the preset punch speed and at half of it: change of
   the edge draw-in and 95th percentile of the shear-angle difference.
 * ``float32_vs_float64``: the same coarse run in both precisions.
@@ -67,6 +69,55 @@ def _per_step(name, size_mm, n=100):
             "build_and_compile_s": t_compile, "full_stroke_estimate_s": t_compile + per * info.n_steps}
 
 
+def _step_split(name, size_mm, n=100):
+    """ms per step of a forming run split into shell forces, tool contact and the rest: each part
+    jitted alone in a ``lax.scan`` of ``n`` steps (best of 3 after compilation); rest = full step
+    minus the two (integrator update, energy accounts, guard)."""
+    import jax.numpy as jnp
+
+    from jaxform import forming
+    from jaxform import shell as shell_mod
+
+    model, state, info = forming.build(_case(name, size_mm))
+    soa = hasattr(shell_mod, "forces_and_energy_soa")
+
+    def best(f, *a):
+        jax.block_until_ready(f(*a))
+        t = []
+        for _ in range(3):
+            t0 = time.perf_counter()
+            jax.block_until_ready(f(*a))
+            t.append(time.perf_counter() - t0)
+        return 1e3 * min(t) / n
+
+    def shell_only(m, x):
+        def one(x, _):
+            if soa:
+                f, p = shell_mod.forces_and_energy_soa(x.T, m.shell)
+                f = f.T
+            else:
+                f, p = shell_mod.forces_and_energy(x, m.shell)
+            return x + 1e-12 * f, p["tension"]
+
+        return jax.lax.scan(one, x, None, length=n)
+
+    def contact_only(m, s):
+        def one(c, _):
+            x, v = c
+            tot = jnp.zeros_like(x)
+            for ld, ls in zip(m.loads, s.loads):
+                tot = tot + ld.force(x, v, s.t, ls)[0]
+            return (x + 1e-12 * tot, v + 1e-9 * tot), None
+
+        return jax.lax.scan(one, (s.x, s.v), None, length=n)[0]
+
+    full = best(jax.jit(lambda m, s: forming.run_steps(m, s, s.energies, s.x, n=n).x), model, state)
+    sh = best(jax.jit(shell_only), model, state.x)
+    co = best(jax.jit(contact_only), model, state)
+    return {"nodes": int(len(info.x0)), "n_steps": info.n_steps, "full_ms": full, "shell_ms": sh, "contact_ms": co,
+            "rest_ms": full - sh - co}
+
+
 def _log(name, value):
     import json
     import sys
@@ -87,13 +138,16 @@ def run(quick: bool = False) -> dict:
     base = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM))
     out["coarse_nlbm"] = _figures(base)
     _log("coarse_nlbm", out["coarse_nlbm"])
-    slow = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM, "process.speed_mm_per_s=250.0"))
+    half = 0.5 * base.info.case.process.speed * 1e3
+    slow = forming.simulate(_case("case-a-woven-nlbm", COARSE_MM, f"process.speed_mm_per_s={half!r}"))
     out["coarse_nlbm_half_speed"] = _figures(slow)
     _log("coarse_nlbm_half_speed", out["coarse_nlbm_half_speed"])
     g1, g2 = np.degrees(base.fields["shear_angle"][-1]), np.degrees(slow.fields["shear_angle"][-1])
     d1, d2 = base.summary["draw_in"]["edge_mid_m"], slow.summary["draw_in"]["edge_mid_m"]
-    out["quasi_static"] = {"draw_in_change": abs(d1 - d2) / abs(d2), "shear_diff_p95_deg": float(np.percentile(
-        np.abs(g1 - g2), 95)), "wall_time_ratio": slow.wall_time_s / base.wall_time_s}
+    out["quasi_static"] = {"speeds_mm_per_s": [2 * half, half], "draw_in_change": abs(d1 - d2) / abs(d2),
+                           "shear_diff_p95_deg": float(np.percentile(np.abs(g1 - g2), 95)),
+                           "max_ke_ie": [base.summary["max_ke_ie"], slow.summary["max_ke_ie"]],
+                           "wall_time_ratio": slow.wall_time_s / base.wall_time_s}
     _log("quasi_static", out["quasi_static"])
     jax.config.update("jax_enable_x64", True)
     try:
@@ -120,6 +174,8 @@ def run(quick: bool = False) -> dict:
     c2 = out["case_a_2mm"]
     c2["nlbm_overhead_over_lbm"] = c2["nlbm"]["per_step_s"] / c2["lbm-41"]["per_step_s"] - 1.0
     _log("case_a_2mm", c2)
+    out["step_split_ms"] = {f"{mm:g}mm": _step_split("case-a-woven-nlbm", mm) for mm in (4.0, 2.0)}
+    _log("step_split_ms", out["step_split_ms"])
     # item 7: the OpenRadioss comparison setup
     r = forming.simulate(_case("case-a-woven-lbm-41", 4.0, "process.speed_mm_per_s=1000.0"))
     out["openradioss_setup"] = _figures(r)

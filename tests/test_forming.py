@@ -104,3 +104,28 @@ def test_gradients_of_a_short_run_match_finite_differences():
         g = np.asarray(jac[i])
         assert np.all(np.abs(fd) > 0)
         np.testing.assert_allclose(g, fd, rtol=1e-3)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=False, reason=(
+    "issue 4 item 1 not met at the preset 500 mm/s: full-map p95 shear difference 2.3 deg (500 vs 250 mm/s), "
+    "4.1 deg (250 vs 125), 1.2 deg (125 vs 62.5) on 8 mm elements; draw-in within 1%. Cause: the lift of the "
+    "unclamped flange into the 7 mm gap is a sequence of buckling events that lag the punch by a roughly "
+    "constant time (inertia against ~2 Pa of weight and the bending stiffness); friction regularisation "
+    "(0.1 deg) and rounding (float32 vs float64: 0.14 deg) are not the cause"))
+def test_quasi_static_halving_the_punch_speed_changes_little():
+    """Issue 4 item 1 at the preset punch speed, woven Case A (NLBM) on 8 mm elements: halving the
+    speed changes the edge draw-in by < 2% and the shear-angle map by < 1 deg at the 95th
+    percentile of all nodes (flange included)."""
+    case = _coarse("case-a-woven-nlbm", size_mm=8.0)
+    half = cases.apply_overrides(case, [f"process.speed_mm_per_s={0.5 * case.process.speed * 1e3!r}"])
+    runs = [forming.simulate(c) for c in (case, half)]
+    assert all(r.complete for r in runs), [r.reason for r in runs]
+    d = [r.summary["draw_in"]["edge_mid_m"] for r in runs]
+    assert abs(d[0] - d[1]) < 0.02 * abs(d[1]), d
+    g = [np.degrees(r.fields["shear_angle"][-1]) for r in runs]
+    assert g[0].shape == g[1].shape == (len(runs[0].info.x0),)
+    p95 = float(np.percentile(np.abs(g[0] - g[1]), 95))
+    assert p95 < 1.0, p95
+    for r in runs:  # reported (a poor test alone: the fabric stores little energy)
+        assert r.summary["max_ke_ie"] is not None

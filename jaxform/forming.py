@@ -286,7 +286,8 @@ def with_fabric(model, fabric):
 
 
 def run_steps(model, state, e0, x_ref, n: int, blowup_tol: float = 1e30):
-    """``n`` integrator steps (pure; ``lax.scan`` of :func:`jaxform.integrate.step`).
+    """``n`` integrator steps (pure; :func:`jaxform.integrate.run_steps`: a failed stretch returns
+    its starting state with the failing step recorded).
 
     The integrator's own energy-blow-up guard is off by default (``blowup_tol`` huge): at the
     start of a forming run every energy is at the float32 noise floor (~1e-9 J) and that guard,
@@ -294,10 +295,7 @@ def run_steps(model, state, e0, x_ref, n: int, blowup_tol: float = 1e30):
     :func:`simulate` checks the energy balance per chunk against a floor (:data:`ENERGY_FLOOR`).
     """
 
-    def one(s, _):
-        return integrate.step(model, s, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol), None
-
-    return jax.lax.scan(one, state, None, length=n)[0]
+    return integrate.run_steps(model, state, n, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol)[0]
 
 
 _run_steps_jit = jax.jit(run_steps, static_argnames=("n", "blowup_tol"))

@@ -50,8 +50,9 @@ def test_orientations_rotate_the_fibres():
     assert model.shell.fabrics[0].fibre_angles == pytest.approx((math.radians(30), math.radians(120)))
 
 
-def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N():
-    case = _coarse("case-b-woven-nlbm", size_mm=25.0, process__stroke_mm=5, process__frames=2)
+@pytest.mark.parametrize("fabric", ["woven", "ncf"])
+def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N(fabric):
+    case = _coarse(f"case-b-{fabric}-nlbm", size_mm=25.0, process__stroke_mm=5, process__frames=2)
     r = forming.simulate(case, samples_per_frame=12)
     assert r.complete, r.reason
     h = case.ply_thickness

@@ -30,7 +30,7 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass
 from jaxform.model import Energies, Hold, Model, State
-from jaxform.shell import Shell, forces_and_energy, forces_and_energy_soa, stable_time_step
+from jaxform.shell import Shell, forces_and_energy, forces_and_energy_sym, stable_time_step
 
 
 class SimulationError(RuntimeError):
@@ -132,7 +132,7 @@ def _step(model: Model, state: State, x_ref, blowup_tol):
     x, v_old, t = state.x, state.v, state.t
     xs, vs_old = x.T, v_old.T
     first = state.step == 0
-    f_int, parts = forces_and_energy_soa(xs, model.shell)
+    f_int, parts = forces_and_energy_sym(xs, model.shell)
     f_grav = m * model.gravity[:, None]
     f_damp = -model.damping * m * vs_old
     f_loads = jnp.zeros_like(xs)

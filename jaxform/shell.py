@@ -366,6 +366,51 @@ def forces_and_energy_soa(xs, shell: Shell):
     return -grad_s, parts
 
 
+def _parts_soa(xs, shell: Shell):
+    e1, e2 = _edges(xs, shell.mesh)
+    D = _derivs_soa(xs, shell.mesh) if _has_bending(shell) else None
+    return _local_energy(e1, e2, D, shell)[1]
+
+
+@jax.custom_vjp
+def forces_and_energy_sym(xs, shell: Shell):
+    """:func:`forces_and_energy_soa` whose reverse mode uses the symmetry of the Hessian.
+
+    Same values. Cotangents ``(r, c)`` of the forces (3, N) and of the energy parts give
+    ``x_bar = -H r + grad(sum_k c_k E_k)`` with ``-H r`` taken as the *forward* derivative of the
+    forces along ``r`` (``-H`` is symmetric), and ``shell_bar = d/dshell(-grad E . r + sum_k c_k E_k)``.
+    Plain reverse mode would transpose every gather of the kernel into a scatter (slow on CPU);
+    this way the backward pass has the forward pass's structure. Reverse mode only (no ``jvp``):
+    the integrator uses it, :func:`forces_and_energy` stays plain.
+    """
+    return forces_and_energy_soa(xs, shell)
+
+
+def _sym_fwd(xs, shell):
+    return forces_and_energy_soa(xs, shell), (xs, shell)
+
+
+def _sym_bwd(res, ct):
+    xs, shell = res
+    r, c = ct
+    _, x_bar = jax.jvp(lambda y: forces_and_energy_soa(y, shell)[0], (xs,), (r,))
+
+    def phi(y, sh):
+        de_r = jax.jvp(lambda z: sum(_parts_soa(z, sh).values()), (y,), (r,))[1]
+        parts = _parts_soa(y, sh)
+        return sum(c[k] * parts[k] for k in parts) - de_r
+
+    # d phi / d y = sum c_k grad E_k - H r; only the first term is still needed (x_bar has -H r):
+    _, vjp = jax.vjp(lambda sh: phi(xs, sh), shell)
+    (shell_bar,) = vjp(jnp.ones((), xs.dtype))
+    _, vjp_x = jax.vjp(lambda y: sum(c[k] * v for k, v in _parts_soa(y, shell).items()), xs)
+    (x_parts,) = vjp_x(jnp.ones((), xs.dtype))
+    return x_bar + x_parts, shell_bar
+
+
+forces_and_energy_sym.defvjp(_sym_fwd, _sym_bwd)
+
+
 def forces(x, shell: Shell):
     """Internal nodal forces ``-dE/dx`` (N, 3), N."""
     return forces_and_energy(x, shell)[0]

@@ -567,6 +567,7 @@ def apply_overrides(case: Case, assignments) -> Case:
     ``--set holder.gap_mm=5 --set plies.orientations_deg=[0,45]``; each is validated like a file.
     """
     d = to_dict(case)
+    assignments = list(assignments)
     for item in assignments:
         if "=" not in item:
             raise ValueError(f"override {item!r}: expected key=value (e.g. holder.gap_mm=5)")
@@ -587,6 +588,10 @@ def apply_overrides(case: Case, assignments) -> Case:
             if not isinstance(target, dict):
                 raise ValueError(f"unknown case key '{key}' in override {item!r}")
         target[rest[-1]] = value
+    changed = [a.strip() for a in assignments if a.split("=", 1)[0].strip() != "description"]
+    if changed and not any(a.split("=", 1)[0].strip() == "description" for a in assignments):
+        # a preset's text names its own element size, holder mode...: say what was changed
+        d["description"] = f"{d.get('description', '')} (overridden: {', '.join(changed)})".strip()
     return from_dict(d)
 
 

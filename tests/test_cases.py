@@ -129,3 +129,9 @@ def test_toml_file_roundtrip_and_unknown_names(tmp_path):
     (tmp_path / "broken.toml").write_text("name = ")
     with pytest.raises(ValueError, match="not valid TOML"):
         cases.load(str(tmp_path / "broken.toml"))
+
+
+def test_overrides_are_named_in_the_description():
+    c = cases.with_element_size(cases.load("case-a-woven-nlbm"), 4e-3)
+    assert "2 mm elements" in c.description and "blank.element_size_mm=4.0" in c.description
+    assert cases.apply_overrides(c, ['description="my run"']).description == "my run"

@@ -298,7 +298,9 @@ def _bending_density(D, shell: Shell, n0: int, n1: int, fab):
     return an * (fab.bending[0].energy(k[0]) + fab.bending[1].energy(k[1]))
 
 
-def _local_energy(e1, e2, D, shell: Shell):
+def _local_energy(e1, e2, D, shell: Shell, weights=None):
+    """``(sum_k w_k E_k, parts)`` from the edges and node derivatives; ``weights`` (tension, shear,
+    bending) default to 1 (the total energy)."""
     mesh = shell.mesh
     dtype = e1.dtype
     tension = jnp.zeros((), dtype)
@@ -311,7 +313,10 @@ def _local_energy(e1, e2, D, shell: Shell):
         if fab.bending is not None:
             bending = bending + jnp.sum(_bending_density(D[:, :, n0:n1], shell, n0, n1, fab))
     parts = {"tension": tension, "shear": shear, "bending": bending}
-    return tension + shear + bending, parts
+    if weights is None:
+        return tension + shear + bending, parts
+    wt, ws, wb = weights
+    return wt * tension + ws * shear + wb * bending, parts
 
 
 def _has_bending(shell: Shell) -> bool:
@@ -320,7 +325,10 @@ def _has_bending(shell: Shell) -> bool:
 
 def energy_parts(x, shell: Shell):
     """Elastic energies (J) of the deformed plies ``x`` (N, 3): dict(tension, shear, bending)."""
-    xs = x.T
+    return _parts_soa(x.T, shell)
+
+
+def _parts_soa(xs, shell: Shell):
     e1, e2 = _edges(xs, shell.mesh)
     D = _derivs_soa(xs, shell.mesh) if _has_bending(shell) else None
     return _local_energy(e1, e2, D, shell)[1]
@@ -344,14 +352,18 @@ def forces_and_energy(x, shell: Shell):
     return f.T, parts
 
 
-def forces_and_energy_soa(xs, shell: Shell):
-    """:func:`forces_and_energy` on structure-of-arrays positions (3, N): forces (3, N), parts."""
+def forces_and_energy_soa(xs, shell: Shell, weights=None):
+    """:func:`forces_and_energy` on structure-of-arrays positions (3, N): forces (3, N), parts.
+
+    ``weights`` (tension, shear, bending): the forces of the weighted energy ``sum_k w_k E_k``
+    instead of the total (the parts returned are unweighted).
+    """
     mesh = shell.mesh
     e1, e2 = _edges(xs, mesh)
     has_b = _has_bending(shell)
     D = _derivs_soa(xs, mesh) if has_b else None
     argnums = (0, 1, 2) if has_b else (0, 1)
-    (_, parts), grads = jax.value_and_grad(_local_energy, argnums=argnums, has_aux=True)(e1, e2, D, shell)
+    (_, parts), grads = jax.value_and_grad(_local_energy, argnums=argnums, has_aux=True)(e1, e2, D, shell, weights)
     g1, g2 = grads[0], grads[1]
     t = mesh.tris
     ids = jnp.concatenate([t[:, 0], t[:, 1], t[:, 2]])
@@ -364,12 +376,6 @@ def forces_and_energy_soa(xs, shell: Shell):
     else:
         grad_s = jnp.zeros_like(xs).at[:, ids].add(vals)
     return -grad_s, parts
-
-
-def _parts_soa(xs, shell: Shell):
-    e1, e2 = _edges(xs, shell.mesh)
-    D = _derivs_soa(xs, shell.mesh) if _has_bending(shell) else None
-    return _local_energy(e1, e2, D, shell)[1]
 
 
 @jax.custom_vjp
@@ -393,19 +399,18 @@ def _sym_fwd(xs, shell):
 def _sym_bwd(res, ct):
     xs, shell = res
     r, c = ct
-    _, x_bar = jax.jvp(lambda y: forces_and_energy_soa(y, shell)[0], (xs,), (r,))
+    c = (c["tension"], c["shear"], c["bending"])
+    # -H r: the forward derivative of the forces along r; sum_k c_k grad E_k: the forces of the
+    # c-weighted energy (same kernel and assembly as the forward pass, no transposed gathers)
+    _, f_r = jax.jvp(lambda y: forces_and_energy_soa(y, shell)[0], (xs,), (r,))
+    f_c = forces_and_energy_soa(xs, shell, weights=c)[0]
 
-    def phi(y, sh):
-        de_r = jax.jvp(lambda z: sum(_parts_soa(z, sh).values()), (y,), (r,))[1]
-        parts = _parts_soa(y, sh)
-        return sum(c[k] * parts[k] for k in parts) - de_r
+    def phi(sh):
+        parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh), (xs,), (r,))
+        return sum(ck * parts[k] - dparts[k] for ck, k in zip(c, ("tension", "shear", "bending")))
 
-    # d phi / d y = sum c_k grad E_k - H r; only the first term is still needed (x_bar has -H r):
-    _, vjp = jax.vjp(lambda sh: phi(xs, sh), shell)
-    (shell_bar,) = vjp(jnp.ones((), xs.dtype))
-    _, vjp_x = jax.vjp(lambda y: sum(c[k] * v for k, v in _parts_soa(y, shell).items()), xs)
-    (x_parts,) = vjp_x(jnp.ones((), xs.dtype))
-    return x_bar + x_parts, shell_bar
+    (shell_bar,) = jax.vjp(phi, shell)[1](jnp.ones((), xs.dtype))
+    return f_r - f_c, shell_bar
 
 
 forces_and_energy_sym.defvjp(_sym_fwd, _sym_bwd)

@@ -43,7 +43,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxform._pytree import pytree_dataclass, static_field
+from jaxform._pytree import pytree_dataclass
 from jaxform.materials import Fabric, PolynomialShear
 from jaxform.mesh import Mesh
 from jaxform.shell import Shell, energy_parts
@@ -490,4 +490,3 @@ def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float 
 
 __all__ = ["simulate", "standard_test", "chord_angle", "CantileverResult", "StandardTestResult",
            "CantileverNotConverged", "GRAVITY", "PEIRCE_ANGLE"]
-_ = static_field

@@ -124,7 +124,7 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
                  bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale())
 
 
-def _step(model: Model, state: State, x_ref, blowup_tol):
+def _step(model: Model, state: State, x_ref):
     # The arithmetic runs on structure-of-arrays vectors (3, N) (contiguous rows vectorise on CPU;
     # (N, 3) with its 3-long trailing axis does not); the state and the load interface stay (N, 3).
     dt = model.dt
@@ -185,7 +185,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     reverts a failed stretch to its start, :func:`_freeze_if_failed`): a per-step select of the
     whole state costs as much as the forces on CPU (it defeats XLA's in-place buffer reuse).
     """
-    x_new, v_new, e, loads, extras, fp = _step(model, state, x_ref, blowup_tol)
+    x_new, v_new, e, loads, extras, fp = _step(model, state, x_ref)
     # every node's position and velocity enters the energies: one non-finite value makes them so
     finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
@@ -202,7 +202,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
 def _freeze_if_failed(start: State, end: State) -> State:
     """``end`` if the stretch ``start -> end`` stayed healthy, else ``start`` (the last good state)
     with ``end``'s step count and failure record."""
-    keep = (start.bad_step < 0) & (end.bad_step >= 0) | (start.bad_step >= 0)
+    keep = end.bad_step >= 0  # a failure record, once set, is never cleared
     frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), start, end)
     return State(x=frozen.x, v=frozen.v, t=frozen.t, step=end.step, energies=frozen.energies,
                  loads=frozen.loads, f_prev=frozen.f_prev, bad_step=end.bad_step, bad_code=end.bad_code,

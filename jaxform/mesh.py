@@ -292,18 +292,18 @@ def _gfd_weights(nodes, frames, neigh, hloc):
     return nbr, w
 
 
-def _drop_self(nbr, w, K: int | None = None):
+def _drop_self(nbr, w):
     """Remove the zero-weight entries that point at the node itself (they contribute nothing).
 
-    Kept entries stay in order at the front of each row; rows are cut to the longest kept row
-    (or to ``K``), the rest padded with the node itself at zero weight.
+    Kept entries stay in order at the front of each row; rows are cut to the longest kept row,
+    the rest padded with the node itself at zero weight.
     """
     n = len(nbr)
     own = (nbr == np.arange(n)[:, None]) & np.all(w == 0.0, axis=1)
     order = np.argsort(own, axis=1, kind="stable")
     nbr = np.take_along_axis(nbr, order, axis=1)
     w = np.take_along_axis(w, order[:, None, :], axis=2)
-    K = int((~own).sum(axis=1).max()) if K is None else K
+    K = int((~own).sum(axis=1).max())
     return nbr[:, :K], w[:, :, :K]
 
 
@@ -334,11 +334,11 @@ def _build(parts, *, quads: bool, shape) -> Mesh:
         else:
             neigh, hloc = _neighbourhoods(nodes, tris, frames)
             nbr, w = _gfd_weights(nodes, frames, neigh, hloc)
-        K = max(K, _drop_self(nbr, w)[0].shape[1])
+        nbr, w = _drop_self(nbr, w)
+        K = max(K, nbr.shape[1])
         per.append((nodes, tris, node_area, frames, tframes, nbr, w))
     for nodes, tris, node_area, frames, tframes, nbr, w in per:
         n, t = len(nodes), len(tris)
-        nbr, w = _drop_self(nbr, w, K)
         pad = K - nbr.shape[1]
         if pad:
             nbr = np.concatenate([nbr, np.tile(np.arange(n)[:, None], (1, pad))], axis=1)

@@ -588,10 +588,9 @@ def apply_overrides(case: Case, assignments) -> Case:
             if not isinstance(target, dict):
                 raise ValueError(f"unknown case key '{key}' in override {item!r}")
         target[rest[-1]] = value
-    changed = [a.strip() for a in assignments if a.split("=", 1)[0].strip() != "description"]
-    if changed and not any(a.split("=", 1)[0].strip() == "description" for a in assignments):
+    if assignments and not any(a.split("=", 1)[0].strip() == "description" for a in assignments):
         # a preset's text names its own element size, holder mode...: say what was changed
-        d["description"] = f"{d.get('description', '')} (overridden: {', '.join(changed)})".strip()
+        d["description"] = f"{d.get('description', '')} (overridden: {', '.join(a.strip() for a in assignments)})".strip()
     return from_dict(d)
 
 

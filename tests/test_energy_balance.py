@@ -1,0 +1,43 @@
+"""Energy balance of a forming run (Case A rig, coarse mesh, a few thousand steps).
+
+Float64: the accounts of the integrator (mid-velocity kinetic energy, trapezoidal load work) close
+to ~1e-5 of the energies, whatever the friction and contact damping. Float32: the balance
+residual grew by ~5e-9 J per step whatever the punch speed or time step (5e-4 J after 1e5 steps
+at 62.5 mm/s, which tripped ``forming.simulate``'s blow-up check): the shell was evaluated on
+absolute positions rounded to float32 (ulp ~7e-9 m at 0.1 m against 8 mm edges), a strain
+jitter of ~1e-6 each step that feeds energy into the stiff fibre-tension modes (the float32 run
+ends with several times the float64 kinetic energy at low speed). Evaluating the shell on the
+displacement from the reference (edges = reference edges + displacement differences) removes it.
+"""
+import jax
+import numpy as np
+import pytest
+
+from jaxform import cases, forming
+
+N_STEPS = 3000
+
+
+def _run(dtype, n=N_STEPS):
+    case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.0125)
+    case = cases.apply_overrides(case, ["process.stroke_mm=10", "process.frames=3"])
+    model, state, _ = forming.build(case, dtype=dtype)
+    run = jax.jit(forming.run_steps, static_argnames=("n",))
+    s = run(model, state, state.energies, state.x, n=n)
+    assert int(s.bad_step) < 0
+    e = s.energies
+    return float(e.balance(state.energies)), float(e.kinetic + e.internal)
+
+
+def test_balance_closes_in_float64():
+    res, stored = _run("float64")
+    assert stored > 1e-6
+    assert abs(res) < 1e-3 * stored  # measured 1.4e-4 (time-step error, ~dt**2)
+
+
+@pytest.mark.xfail(strict=True, reason="float32 shell evaluated on rounded absolute positions heats the "
+                   "membrane (~5e-9 J per step); fix: integrate on the displacement, shell edges from "
+                   "reference edges + displacement differences (integrate.py/shell.py)")
+def test_balance_float32_no_rounding_drift():
+    res, stored = _run("float32")
+    assert abs(res) < 1e-2 * stored  # measured 7.5e-2 before the fix

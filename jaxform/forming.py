@@ -194,7 +194,8 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
     fabrics = ply_fabrics(case, fabric)
     shell = Shell.build(mesh, fabrics)
     ms = float(case.mass_scaling)
-    stable = stable_time_step(shell, mass_scale=ms, safety=1.0)
+    fms = float(case.fibre_mass_scaling)
+    stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
     dt_max = dt_safety * stable if dt is None else float(dt)
     # the automatic penalty stiffness k = safety rho_A / dt^2 must keep the penetration under
     # 1e5 Pa below 10% of the ply (contact_params checks it): on coarse meshes that caps dt
@@ -255,7 +256,8 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
                                      area=as_arr(area[a:b]), params=params_ply))
 
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
-                                 gravity=(0.0, 0.0, -GRAVITY / ms), loads=tuple(loads), dtype=jdtype)
+                                 gravity=(0.0, 0.0, -GRAVITY / ms), loads=tuple(loads), dtype=jdtype,
+                                 fibre_mass_factor=fms, fibre_mass_iters=case.fibre_mass_iters)
     x0 = jnp.asarray(mesh.nodes, jdtype)
     load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
     # jitted: eager (op-by-op) evaluation of the shell forces costs seconds

@@ -28,6 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxform import fibre_mass as _fm
 from jaxform._pytree import pytree_dataclass
 from jaxform.model import Energies, Hold, Model, State
 from jaxform.shell import Shell, forces_and_energy, forces_and_energy_sym, stable_time_step
@@ -73,15 +74,19 @@ class Frames:
 
 def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, mass_scale: float = 1.0,
                damping: float = 0.0, gravity=(0.0, 0.0, 0.0), fixed=None, drive=None, loads: tuple = (),
-               dtype=None) -> Model:
+               dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_iters: int | None = None) -> Model:
     """Build a :class:`Model` on the host.
 
     ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.shell.stable_time_step`);
     a user ``dt`` above the limit is kept but warned about. ``mass_scale`` multiplies all masses
-    (raising the stable step by its square root). ``fixed`` (N, 3) bool marks driven dofs
-    (default none), ``drive`` gives their positions (default: held where they are).
+    (raising the stable step by its square root). ``fibre_mass_factor`` ``s`` > 1 adds inertia to
+    fibre stretching only (:mod:`jaxform.fibre_mass`; the membrane limit grows by ``s``, solved
+    with ``fibre_mass_iters`` conjugate-gradient iterations per step). ``fixed`` (N, 3) bool
+    marks driven dofs (default none), ``drive`` gives their positions (default: held where they
+    are); with a fibre mass, driven dofs must move at constant velocity (their acceleration is
+    taken as zero in the solve).
     """
-    dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0)
+    dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
     if dt is None:
         dt = safety * dt_limit
     elif dt > dt_limit:
@@ -100,9 +105,10 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
         raise ValueError(f"make_model: fixed has shape {fixed.shape}: need ({n}, 3) booleans (driven dofs)")
     drive = Hold(x0) if drive is None else drive
     mass = jnp.asarray(shell.node_masses(mass_scale), dtype)
+    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, iters=fibre_mass_iters, dtype=dtype)
     return Model(shell=shell, mass=mass, fixed=fixed, drive=drive, gravity=jnp.asarray(gravity, dtype),
                  damping=jnp.asarray(damping, dtype), dt=jnp.asarray(dt, dtype), loads=tuple(loads),
-                 mass_scale=mass_scale)
+                 mass_scale=mass_scale, fibre_mass=fm)
 
 
 def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -> State:
@@ -115,13 +121,16 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
     v = jnp.zeros_like(x) if v is None else jnp.asarray(v, dtype)
     _, parts = forces_and_energy(x, model.shell)
     ke = 0.5 * jnp.sum(model.mass[:, None] * v * v)
+    if model.fibre_mass is not None:
+        ke = ke + _fm.added_kinetic_energy(v.T, _fm.fibre_units(x.T, model.shell), model.fibre_mass, model.shell)
     z = jnp.zeros((), dtype)
     e = Energies(ke, parts["tension"], parts["shear"], parts["bending"], z, z, z, z)
     loads = tuple(None for _ in model.loads) if load_states is None else tuple(load_states)
     zero = jnp.zeros_like(x.T)  # SoA (3, N), as the step keeps them
     return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
                  f_prev=(zero, zero, zero), bad_step=jnp.asarray(-1, jnp.int32),
-                 bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale())
+                 bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale(), acc=zero,
+                 solve_residual=jnp.zeros((), dtype))
 
 
 def _step(model: Model, state: State, x_ref):
@@ -145,20 +154,31 @@ def _step(model: Model, state: State, x_ref):
     f_free = f_int + f_grav + f_damp + f_loads
     # on the first step the initial velocity is the full-step velocity: advance half a step
     h = jnp.where(first, 0.5 * dt, dt)
-    v_free = vs_old + h * f_free / m
     fixed = model.fixed.T
+    fm = model.fibre_mass
+    if fm is None:
+        acc, resid = f_free / m, jnp.zeros((), xs.dtype)
+    else:
+        units = _fm.fibre_units(xs, model.shell)
+        acc, resid = _fm.solve(units, f_free, state.acc, model.mass, jnp.where(fixed, 0.0, 1.0).astype(xs.dtype),
+                               fm, model.shell)
+    v_free = vs_old + h * acc
     x_drive = model.drive.position(t + dt).T
     v_drive = (x_drive - xs) / dt
     v_new = jnp.where(fixed, v_drive, v_free)
     x_new = xs + dt * v_new
+    # (with a fibre mass: the lumped part only; driven dofs move at constant velocity there)
     reaction = jnp.where(fixed, m * (v_new - vs_old) / h - f_free, 0.0)
     # energies at step n: kinetic with the mid velocity, work by the trapezoidal rule over x_{n-1} -> x_n
     v_mid = jnp.where(first, vs_old, 0.5 * (vs_old + v_new))
     dx = jnp.where(first, 0.0, dt * vs_old)
     fl0, fd0, fr0 = state.f_prev
     e_old = state.energies
+    kinetic = 0.5 * jnp.sum(m * v_mid * v_mid)
+    if fm is not None:
+        kinetic = kinetic + _fm.added_kinetic_energy(v_mid, units, fm, model.shell)
     e = Energies(
-        kinetic=0.5 * jnp.sum(m * v_mid * v_mid),
+        kinetic=kinetic,
         tension=parts["tension"],
         shear=parts["shear"],
         bending=parts["bending"],
@@ -167,7 +187,7 @@ def _step(model: Model, state: State, x_ref):
         boundary_work=e_old.boundary_work + 0.5 * jnp.sum((fr0 + reaction) * dx),
         damping_work=e_old.damping_work - 0.5 * jnp.sum((fd0 + f_damp) * dx),
     )
-    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction)
+    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (acc, resid)
 
 
 def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
@@ -185,7 +205,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     reverts a failed stretch to its start, :func:`_freeze_if_failed`): a per-step select of the
     whole state costs as much as the forces on CPU (it defeats XLA's in-place buffer reuse).
     """
-    x_new, v_new, e, loads, extras, fp = _step(model, state, x_ref)
+    x_new, v_new, e, loads, extras, fp, (acc, resid) = _step(model, state, x_ref)
     # every node's position and velocity enters the energies: one non-finite value makes them so
     finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
@@ -195,7 +215,8 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     fail_now = (state.bad_step < 0) & (code > 0)
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
                 f_prev=fp, bad_step=jnp.where(fail_now, state.step, state.bad_step),
-                bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max))
+                bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max),
+                acc=acc, solve_residual=resid)
     return new, extras
 
 
@@ -206,7 +227,7 @@ def _freeze_if_failed(start: State, end: State) -> State:
     frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), start, end)
     return State(x=frozen.x, v=frozen.v, t=frozen.t, step=end.step, energies=frozen.energies,
                  loads=frozen.loads, f_prev=frozen.f_prev, bad_step=end.bad_step, bad_code=end.bad_code,
-                 scale_max=frozen.scale_max)
+                 scale_max=frozen.scale_max, acc=frozen.acc, solve_residual=frozen.solve_residual)
 
 
 def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None, x_ref=None,

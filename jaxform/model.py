@@ -69,6 +69,8 @@ class Model:
         dt: time step, s.
         loads: tuple of external loads (see the module docstring).
         mass_scale: the factor applied to the physical masses (1 = none), for reports.
+        fibre_mass: ``None`` or a :class:`~jaxform.fibre_mass.FibreMass`: inertia added to fibre
+            stretching only (accelerations then come from a linear solve each step).
     """
 
     shell: Shell
@@ -80,6 +82,7 @@ class Model:
     dt: Any
     loads: tuple = ()
     mass_scale: Any = 1.0
+    fibre_mass: Any = None
 
     def replace(self, **changes) -> "Model":
         import dataclasses
@@ -138,6 +141,10 @@ class State:
             structure-of-arrays layout (work accounts by the trapezoidal rule).
         bad_step: -1 while the run is healthy, else the first step that failed (run is frozen).
         bad_code: 0 ok, 1 non-finite values, 2 energy blow-up.
+        scale_max: the largest energy scale seen, J.
+        acc: (3, N) accelerations of the last step (SoA), m/s² (the warm start of the
+            fibre-mass solve).
+        solve_residual: relative residual of the last fibre-mass solve (0 without it).
     """
 
     x: Any
@@ -150,6 +157,8 @@ class State:
     bad_step: Any
     bad_code: Any
     scale_max: Any
+    acc: Any = None
+    solve_residual: Any = None
 
 
 __all__ = ["Model", "State", "Energies", "Hold", "LinearDrive"]

@@ -22,6 +22,15 @@ Friction (regularised Coulomb)
     (``-mu F_n / eps_v``). The price is creep: a node held by a tangential load ``F < mu F_n``
     slides at ``v = eps_v r / sqrt(1 - r**2)``, ``r = F / (mu F_n)``. Choose ``eps_v`` small
     against the process speed (``jaxform.cases`` uses 1% of the punch speed).
+    In stick that slope acts on the node as a viscous damper ``c = mu p A / eps_v``, integrated
+    explicitly: stable only while ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent
+    of the mesh). Under a clamped holder (Case B, ~15 kPa) with a 1% regularisation that ratio
+    reached 5-8 and the tangential velocity flipped sign every step (chatter, then a blow-up).
+    So ``eps_v`` is raised where needed to ``mu p * stick_limit`` with ``stick_limit = n dt /
+    rho_A`` (tools) or ``2 n dt / rho_A`` (ply on ply: two nodes share the slip), ``n`` the number
+    of frictional interfaces a node can have at once (2 in a stack: holder above, ply below), which
+    holds the summed ratio at 1: more creep under high pressure and large steps, never an
+    unstable stick (an 8 mm Case B stack blew up with the per-interface limit alone).
 
 Penalty stiffness (automatic)
     A node of mass ``m = rho_A A`` on a contact spring ``k A`` oscillates at ``omega**2 = k /
@@ -56,6 +65,8 @@ class ContactParams:
         slip_velocity: regularisation velocity ``eps_v`` of the friction law, m/s.
         damping: normal damping per unit area ``c``, Pa·s/m (0: none).
         smooth_width: width ``w`` of the C1 penetration ramp, m (0: plain ``max(-g, 0)``).
+        stick_limit: ``dt / rho_A`` (per unit of ``mu p``), s·m²/kg: the regularisation velocity
+            is at least ``mu p stick_limit`` so that explicit stick stays stable (0: no limit).
     """
 
     stiffness: Any
@@ -63,16 +74,18 @@ class ContactParams:
     slip_velocity: Any = 1.0e-3
     damping: Any = 0.0
     smooth_width: Any = 0.0
+    stick_limit: Any = 0.0
 
     def __post_init__(self):
-        vals = (self.stiffness, self.friction, self.slip_velocity, self.damping, self.smooth_width)
+        vals = (self.stiffness, self.friction, self.slip_velocity, self.damping, self.smooth_width, self.stick_limit)
         if is_concrete(*vals):
             validate.positive("ContactParams", "stiffness", self.stiffness, "Pa/m")
             validate.nonnegative("ContactParams", "friction", self.friction)
             validate.positive("ContactParams", "slip_velocity", self.slip_velocity, "m/s")
             validate.nonnegative("ContactParams", "damping", self.damping, "Pa·s/m")
             validate.nonnegative("ContactParams", "smooth_width", self.smooth_width, "m")
-            for n in ("stiffness", "friction", "slip_velocity", "damping", "smooth_width"):
+            validate.nonnegative("ContactParams", "stick_limit", self.stick_limit, "s·m²/kg")
+            for n in ("stiffness", "friction", "slip_velocity", "damping", "smooth_width", "stick_limit"):
                 object.__setattr__(self, n, as_leaf(getattr(self, n)))
 
 
@@ -147,7 +160,8 @@ def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
     pressure = jnp.maximum(p_elastic + p_damp, 0.0)
     f_n = pressure * area
     v_t = v_rel - v_n * normal
-    f_t = regularised_friction(v_t, f_n, params.friction, params.slip_velocity)
+    eps_v = jnp.maximum(params.slip_velocity, params.friction * pressure * params.stick_limit)
+    f_t = regularised_friction(v_t, f_n, params.friction, eps_v)
     force = f_n * normal + f_t
     return force, pressure, g, area * params.stiffness * e, -jnp.dot(f_t, v_t)
 
@@ -314,8 +328,12 @@ def auto_penalty_stiffness(areal_mass, dt, *, safety: float = 0.1):
 
 def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_velocity: float = 1.0e-3,
                    stiffness=None, damping_ratio: float = 0.1, expected_pressure: float = 1.0e5,
-                   max_penetration: float = 0.1, safety: float = 0.1) -> ContactParams:
-    """:class:`ContactParams` with the penalty stiffness chosen automatically (or ``stiffness``).
+                   max_penetration: float = 0.1, safety: float = 0.1, two_sided: bool = False,
+                   interfaces: int = 1) -> ContactParams:
+    """:class:`ContactParams` with the penalty stiffness chosen automatically (or ``stiffness``)
+    and the stick limit ``interfaces * dt / areal_mass``, doubled for ``two_sided`` (ply-on-ply)
+    contact; ``interfaces``: how many frictional contacts a node can have at once (2 in a stack:
+    the stick dampers of both act on it and their ratios add up).
 
     Also checks, at the edge, that the penetration under ``expected_pressure`` (Pa; 1e5 Pa is well
     above the holder pressure of the paper's 1000 N case) stays below ``max_penetration`` times
@@ -334,7 +352,8 @@ def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_ve
                 "a larger stiffness with a smaller step"
             )
     c = 2.0 * damping_ratio * jnp.sqrt(k * areal_mass) if damping_ratio else 0.0
-    return ContactParams(stiffness=k, friction=friction, slip_velocity=slip_velocity,
+    limit = (2.0 if two_sided else 1.0) * interfaces * dt / areal_mass
+    return ContactParams(stiffness=k, friction=friction, slip_velocity=slip_velocity, stick_limit=limit,
                          damping=float(c) if is_concrete(c) else c)
 
 

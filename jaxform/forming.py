@@ -55,9 +55,8 @@ from jaxform.shell import Shell, fibre_curvatures, fibre_vectors, shear_angle, s
 
 GRAVITY = 9.81
 ENERGY_FLOOR = {"float32": 1e-3, "float64": 1e-8}
-"""J: an energy-balance residual below this never counts as a blow-up. In float32 the positions'
-rounding (ulp ~7e-9 m at 0.1 m) feeds a random walk of high-frequency membrane energy, ~1e-5 J
-after a few thousand steps on a coarse blank, which the balance sees as a residual."""
+"""J: an energy-balance residual below this never counts as a blow-up (float32 rounding noise of
+the accounts; the shell itself works on displacements, see :class:`jaxform.shell.ShellRef`)."""
 PUNCH, DIE, HOLDER = 0, 1, 2
 
 
@@ -217,10 +216,13 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
     speed = float(case.process.speed)
     mu_tool = float(fab0.friction_tool)
     mu_fab = float(fab0.friction_fabric)
+    n_if = 2 if case.n_plies > 1 else 1  # frictional contacts per node (stack: tool + ply, or two plies)
     params_tool = contact.contact_params(rho, dt, h, friction=mu_tool, slip_velocity=c.slip_velocity_fraction * speed,
-                                         stiffness=c.penalty_stiffness, damping_ratio=c.damping_ratio, safety=c.safety)
+                                         stiffness=c.penalty_stiffness, damping_ratio=c.damping_ratio, safety=c.safety,
+                                         interfaces=n_if)
     params_ply = contact.contact_params(rho, dt, h, friction=mu_fab, slip_velocity=c.slip_velocity_fraction * speed,
-                                        stiffness=c.penalty_stiffness, damping_ratio=c.damping_ratio, safety=c.safety)
+                                        stiffness=c.penalty_stiffness, damping_ratio=c.damping_ratio, safety=c.safety,
+                                        two_sided=True, interfaces=n_if)
 
     n = mesh.n_nodes
     area = np.asarray(mesh.node_area, np.float64)

@@ -31,7 +31,7 @@ import numpy as np
 from jaxform import fibre_mass as _fm
 from jaxform._pytree import pytree_dataclass
 from jaxform.model import Energies, Hold, Model, State
-from jaxform.shell import Shell, forces_and_energy, forces_and_energy_sym, stable_time_step
+from jaxform.shell import Shell, forces_and_energy_sym, stable_time_step
 
 
 class SimulationError(RuntimeError):
@@ -119,7 +119,8 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
     dtype = model.mass.dtype
     x = jnp.asarray(model.shell.mesh.nodes if x is None else x, dtype)
     v = jnp.zeros_like(x) if v is None else jnp.asarray(v, dtype)
-    _, parts = forces_and_energy(x, model.shell)
+    u = (x - jnp.asarray(model.shell.mesh.nodes, dtype)).T
+    _, parts = forces_and_energy_sym(u, model.shell)
     ke = 0.5 * jnp.sum(model.mass[:, None] * v * v)
     if model.fibre_mass is not None:
         ke = ke + _fm.added_kinetic_energy(v.T, _fm.fibre_units(x.T, model.shell), model.fibre_mass, model.shell)
@@ -130,7 +131,7 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
     return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
                  f_prev=(zero, zero, zero), bad_step=jnp.asarray(-1, jnp.int32),
                  bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale(), acc=zero,
-                 solve_residual=jnp.zeros((), dtype))
+                 solve_residual=jnp.zeros((), dtype), u=u)
 
 
 def _step(model: Model, state: State, x_ref):
@@ -138,10 +139,12 @@ def _step(model: Model, state: State, x_ref):
     # (N, 3) with its 3-long trailing axis does not); the state and the load interface stay (N, 3).
     dt = model.dt
     m = model.mass[None, :]
+    # the shell sees displacements from the reference (ShellRef.edge0): absolute float32
+    # positions would add a rounding noise to every strain, every step
     x, v_old, t = state.x, state.v, state.t
-    xs, vs_old = x.T, v_old.T
+    xs, vs_old, us = x.T, v_old.T, state.u
     first = state.step == 0
-    f_int, parts = forces_and_energy_sym(xs, model.shell)
+    f_int, parts = forces_and_energy_sym(us, model.shell)
     f_grav = m * model.gravity[:, None]
     f_damp = -model.damping * m * vs_old
     f_loads = jnp.zeros_like(xs)
@@ -166,7 +169,8 @@ def _step(model: Model, state: State, x_ref):
     x_drive = model.drive.position(t + dt).T
     v_drive = (x_drive - xs) / dt
     v_new = jnp.where(fixed, v_drive, v_free)
-    x_new = xs + dt * v_new
+    u_new = us + dt * v_new
+    x_new = jnp.asarray(model.shell.mesh.nodes, xs.dtype).T + u_new
     # (with a fibre mass: the lumped part only; driven dofs move at constant velocity there)
     reaction = jnp.where(fixed, m * (v_new - vs_old) / h - f_free, 0.0)
     # energies at step n: kinetic with the mid velocity, work by the trapezoidal rule over x_{n-1} -> x_n
@@ -187,7 +191,7 @@ def _step(model: Model, state: State, x_ref):
         boundary_work=e_old.boundary_work + 0.5 * jnp.sum((fr0 + reaction) * dx),
         damping_work=e_old.damping_work - 0.5 * jnp.sum((fd0 + f_damp) * dx),
     )
-    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (acc, resid)
+    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (acc, resid, u_new)
 
 
 def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
@@ -205,7 +209,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     reverts a failed stretch to its start, :func:`_freeze_if_failed`): a per-step select of the
     whole state costs as much as the forces on CPU (it defeats XLA's in-place buffer reuse).
     """
-    x_new, v_new, e, loads, extras, fp, (acc, resid) = _step(model, state, x_ref)
+    x_new, v_new, e, loads, extras, fp, (acc, resid, u_new) = _step(model, state, x_ref)
     # every node's position and velocity enters the energies: one non-finite value makes them so
     finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
@@ -216,7 +220,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
                 f_prev=fp, bad_step=jnp.where(fail_now, state.step, state.bad_step),
                 bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max),
-                acc=acc, solve_residual=resid)
+                acc=acc, solve_residual=resid, u=u_new)
     return new, extras
 
 
@@ -227,7 +231,7 @@ def _freeze_if_failed(start: State, end: State) -> State:
     frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), start, end)
     return State(x=frozen.x, v=frozen.v, t=frozen.t, step=end.step, energies=frozen.energies,
                  loads=frozen.loads, f_prev=frozen.f_prev, bad_step=end.bad_step, bad_code=end.bad_code,
-                 scale_max=frozen.scale_max, acc=frozen.acc, solve_residual=frozen.solve_residual)
+                 scale_max=frozen.scale_max, acc=frozen.acc, solve_residual=frozen.solve_residual, u=frozen.u)
 
 
 def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None, x_ref=None,

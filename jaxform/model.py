@@ -145,6 +145,8 @@ class State:
         acc: (3, N) accelerations of the last step (SoA), m/s² (the warm start of the
             fibre-mass solve).
         solve_residual: relative residual of the last fibre-mass solve (0 without it).
+        u: (3, N) displacements from the mesh nodes (SoA), m: the integrated quantity (``x`` is
+            ``X + u``; the shell is evaluated on ``u``, see :class:`~jaxform.shell.ShellRef`).
     """
 
     x: Any
@@ -159,6 +161,7 @@ class State:
     scale_max: Any
     acc: Any = None
     solve_residual: Any = None
+    u: Any = None
 
 
 __all__ = ["Model", "State", "Energies", "Hold", "LinearDrive"]

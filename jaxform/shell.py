@@ -61,6 +61,12 @@ class ShellRef:
         theta0: (T,) reference angle between the families, rad.
         node_dir: (N, 2, 2) reference fibre direction ``(c, s)`` of each family in the node frame.
         kappa0: (N, 2) reference fibre curvature, 1/m (zero for a flat blank).
+        edge0: (2, 3, T) reference edge vectors ``x1 - x0``, ``x2 - x0`` of every triangle, m.
+        deriv0: (5, 3, N) reference node derivatives ``X_X .. X_YY`` (the stencil on the mesh).
+            With these, the kernel can take displacements (``*_disp``): the edges and derivatives
+            are then ``reference + linear(u)``, free of the rounding of absolute positions (in
+            float32 a 0.1 m coordinate is rounded to 7e-9 m, a strain noise of 1e-6 on 8 mm
+            edges every step, which heats the stiff fibre modes of a long explicit run).
     """
 
     tri_area: Any
@@ -69,6 +75,8 @@ class ShellRef:
     theta0: Any
     node_dir: Any
     kappa0: Any
+    edge0: Any = None
+    deriv0: Any = None
 
 
 def shell_reference(mesh: Mesh, fibre_angles) -> ShellRef:
@@ -94,10 +102,10 @@ def shell_reference(mesh: Mesh, fibre_angles) -> ShellRef:
     c1, c2 = e0[:, 0], e0[:, 1]
     theta0 = np.arctan2(np.abs(c1[:, 0] * c2[:, 1] - c1[:, 1] * c2[:, 0]), np.sum(c1 * c2, -1))
     node_dir = np.stack([np.cos(node_ang), np.sin(node_ang)], axis=-1)  # (N, 2, 2)
-    ref = ShellRef(tri_area=area, tri_dm_inv=dm_inv, tri_coef=coef, theta0=theta0, node_dir=node_dir,
-                   kappa0=np.zeros((len(nodes), 2)))
     k0 = _fibre_curvatures_np(nodes, mesh, node_dir)
-    return ShellRef(tri_area=area, tri_dm_inv=dm_inv, tri_coef=coef, theta0=theta0, node_dir=node_dir, kappa0=k0)
+    deriv0 = np.einsum("nmk,nkc->mcn", np.asarray(mesh.gfd), nodes[np.asarray(mesh.nbr)] - nodes[:, None, :])
+    return ShellRef(tri_area=area, tri_dm_inv=dm_inv, tri_coef=coef, theta0=theta0, node_dir=node_dir, kappa0=k0,
+                    edge0=np.stack([e1.T, e2.T]), deriv0=deriv0)
 
 
 def _fibre_curvatures_np(x, mesh: Mesh, node_dir):
@@ -132,10 +140,14 @@ def _safe_norm(v):
 # CPU, where (n, 3) layouts with tiny trailing axes do not (measured: 5-10x).
 
 
-def _edges(xs, mesh: Mesh):
+def _edges(xs, mesh: Mesh, base=None):
+    """Triangle edge vectors ``x1 - x0``, ``x2 - x0`` (3, T) each; plus ``base`` (2, 3, T) if given."""
     t = mesh.tris
     x0 = xs[:, t[:, 0]]
-    return xs[:, t[:, 1]] - x0, xs[:, t[:, 2]] - x0
+    e1, e2 = xs[:, t[:, 1]] - x0, xs[:, t[:, 2]] - x0
+    if base is None:
+        return e1, e2
+    return e1 + base[0].astype(xs.dtype), e2 + base[1].astype(xs.dtype)
 
 
 def _fibres_soa(e1, e2, coef):
@@ -161,8 +173,9 @@ def shear_angle(g, ref: ShellRef):
     return ref.theta0.astype(g.dtype) - _angle(g[:, 0].T, g[:, 1].T)
 
 
-def _derivs_soa(xs, mesh: Mesh):
-    """(5, 3, N): x_X, x_Y, x_XX, x_XY, x_YY at every node, from SoA positions (3, N).
+def _derivs_soa(xs, mesh: Mesh, base=None):
+    """(5, 3, N): x_X, x_Y, x_XX, x_XY, x_YY at every node, from SoA positions (3, N) (plus
+    ``base`` (5, 3, N) if given).
 
     One gather of all neighbour slots; the derivatives are materialised
     (``optimization_barrier``): left fusible, XLA re-gathers the neighbours inside every consumer
@@ -175,6 +188,8 @@ def _derivs_soa(xs, mesh: Mesh):
     # slice once per operand: each slice's transpose (reverse mode) is a full-size pad
     ds = [d[:, k] for k in range(K)]
     D = jnp.stack([sum(w[k, m][None] * ds[k] for k in range(K)) for m in range(5)])
+    if base is not None:
+        D = D + base.astype(xs.dtype)
     return jax.lax.optimization_barrier(D)
 
 
@@ -328,10 +343,17 @@ def energy_parts(x, shell: Shell):
     return _parts_soa(x.T, shell)
 
 
-def _parts_soa(xs, shell: Shell):
-    e1, e2 = _edges(xs, shell.mesh)
-    D = _derivs_soa(xs, shell.mesh) if _has_bending(shell) else None
-    return _local_energy(e1, e2, D, shell)[1]
+def _kinematics(xs, shell: Shell, displacement: bool):
+    """Edges and node derivatives (``None`` without bending) from positions, or from
+    displacements from the reference (``displacement``)."""
+    ref, mesh = shell.ref, shell.mesh
+    e1, e2 = _edges(xs, mesh, ref.edge0 if displacement else None)
+    D = _derivs_soa(xs, mesh, ref.deriv0 if displacement else None) if _has_bending(shell) else None
+    return e1, e2, D
+
+
+def _parts_soa(xs, shell: Shell, displacement: bool = False):
+    return _local_energy(*_kinematics(xs, shell, displacement), shell)[1]
 
 
 def energy(x, shell: Shell):
@@ -352,16 +374,17 @@ def forces_and_energy(x, shell: Shell):
     return f.T, parts
 
 
-def forces_and_energy_soa(xs, shell: Shell, weights=None):
+def forces_and_energy_soa(xs, shell: Shell, weights=None, displacement: bool = False):
     """:func:`forces_and_energy` on structure-of-arrays positions (3, N): forces (3, N), parts.
 
     ``weights`` (tension, shear, bending): the forces of the weighted energy ``sum_k w_k E_k``
-    instead of the total (the parts returned are unweighted).
+    instead of the total (the parts returned are unweighted). ``displacement``: ``xs`` are the
+    displacements ``x - X`` from the mesh nodes (same forces, without the rounding of absolute
+    positions; see :class:`ShellRef`).
     """
     mesh = shell.mesh
-    e1, e2 = _edges(xs, mesh)
     has_b = _has_bending(shell)
-    D = _derivs_soa(xs, mesh) if has_b else None
+    e1, e2, D = _kinematics(xs, shell, displacement)
     argnums = (0, 1, 2) if has_b else (0, 1)
     (_, parts), grads = jax.value_and_grad(_local_energy, argnums=argnums, has_aux=True)(e1, e2, D, shell, weights)
     g1, g2 = grads[0], grads[1]
@@ -379,21 +402,22 @@ def forces_and_energy_soa(xs, shell: Shell, weights=None):
 
 
 @jax.custom_vjp
-def forces_and_energy_sym(xs, shell: Shell):
-    """:func:`forces_and_energy_soa` whose reverse mode uses the symmetry of the Hessian.
+def forces_and_energy_sym(us, shell: Shell):
+    """:func:`forces_and_energy_soa` on displacements ``us = x - X`` (3, N) whose reverse mode
+    uses the symmetry of the Hessian.
 
-    Same values. Cotangents ``(r, c)`` of the forces (3, N) and of the energy parts give
+    Same values as ``forces_and_energy_soa(us, shell, displacement=True)``. Cotangents ``(r, c)`` of the forces (3, N) and of the energy parts give
     ``x_bar = -H r + grad(sum_k c_k E_k)`` with ``-H r`` taken as the *forward* derivative of the
     forces along ``r`` (``-H`` is symmetric), and ``shell_bar = d/dshell(-grad E . r + sum_k c_k E_k)``.
     Plain reverse mode would transpose every gather of the kernel into a scatter (slow on CPU);
     this way the backward pass has the forward pass's structure. Reverse mode only (no ``jvp``):
     the integrator uses it, :func:`forces_and_energy` stays plain.
     """
-    return forces_and_energy_soa(xs, shell)
+    return forces_and_energy_soa(us, shell, displacement=True)
 
 
-def _sym_fwd(xs, shell):
-    return forces_and_energy_soa(xs, shell), (xs, shell)
+def _sym_fwd(us, shell):
+    return forces_and_energy_soa(us, shell, displacement=True), (us, shell)
 
 
 def _sym_bwd(res, ct):
@@ -402,11 +426,11 @@ def _sym_bwd(res, ct):
     c = (c["tension"], c["shear"], c["bending"])
     # -H r: the forward derivative of the forces along r; sum_k c_k grad E_k: the forces of the
     # c-weighted energy (same kernel and assembly as the forward pass, no transposed gathers)
-    _, f_r = jax.jvp(lambda y: forces_and_energy_soa(y, shell)[0], (xs,), (r,))
-    f_c = forces_and_energy_soa(xs, shell, weights=c)[0]
+    _, f_r = jax.jvp(lambda y: forces_and_energy_soa(y, shell, displacement=True)[0], (xs,), (r,))
+    f_c = forces_and_energy_soa(xs, shell, weights=c, displacement=True)[0]
 
     def phi(sh):
-        parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh), (xs,), (r,))
+        parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh, displacement=True), (xs,), (r,))
         return sum(ck * parts[k] - dparts[k] for ck, k in zip(c, ("tension", "shear", "bending")))
 
     (shell_bar,) = jax.vjp(phi, shell)[1](jnp.ones((), xs.dtype))

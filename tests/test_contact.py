@@ -279,3 +279,33 @@ def test_ply_load_refreshes_candidates():
     f, st, ex = jax.jit(load.force)(x, jnp.zeros_like(x), 0.0, st)
     np.testing.assert_allclose(f[slave, 2], 4e10 * 1e-6 * 4e-6, rtol=1e-9)
     assert int(st[1]) == 1
+
+
+def test_stick_under_high_pressure_is_stable_with_the_stick_limit():
+    """Explicit stick: the regularised friction is a damper ``mu p A / eps_v`` on the node. With
+    ``mu p dt / (eps_v rho_A) = 5`` (a clamped holder, 1% regularisation, 8 mm mesh) the plain law
+    makes the slip velocity flip sign every step and grow; the stick limit of
+    :func:`contact.contact_params` keeps it decaying without a sign change."""
+    dt, p, mu, area = 2.0e-6, 1.5e4, 0.23, 6.4e-5
+    eps = mu * p * dt / (5.0 * RHO_A)
+    base = contact.contact_params(RHO_A, dt, H, friction=mu, slip_velocity=eps)
+    assert float(base.stick_limit) == pytest.approx(dt / RHO_A)
+    plain = contact.ContactParams(stiffness=base.stiffness, friction=mu, slip_velocity=eps)
+    depth = p / float(base.stiffness)
+    m = RHO_A * area
+    node = jax.jit(contact.node_contact)
+    out = {}
+    for name, params in (("plain", plain), ("limited", base)):
+        v = jnp.array([1e-3, 0.0, 0.0])
+        vs = []
+        for _ in range(30):
+            f = node(jnp.asarray(-depth + H / 2), jnp.array([0.0, 0.0, 1.0]), v, H / 2, area, params)[0]
+            v = v + dt * jnp.array([f[0], f[1], 0.0]) / m
+            vs.append(float(v[0]))
+        out[name] = np.array(vs)
+    lim = np.abs(out["limited"])
+    assert np.all(lim[1:] <= lim[:-1]) and lim[-1] < 1e-12  # decays at once (ratio 1), no chatter
+    flips = np.sum(np.sign(out["plain"][1:]) != np.sign(out["plain"][:-1]))
+    assert flips >= 20 and abs(out["plain"][-1]) > 1e-5  # the test sees chatter where it exists
+    # two-sided (ply on ply) contact: twice the limit (two nodes share the slip)
+    assert float(contact.contact_params(RHO_A, dt, H, two_sided=True).stick_limit) == pytest.approx(2 * dt / RHO_A)

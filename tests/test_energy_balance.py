@@ -35,9 +35,6 @@ def test_balance_closes_in_float64():
     assert abs(res) < 1e-3 * stored  # measured 1.4e-4 (time-step error, ~dt**2)
 
 
-@pytest.mark.xfail(strict=True, reason="float32 shell evaluated on rounded absolute positions heats the "
-                   "membrane (~5e-9 J per step); fix: integrate on the displacement, shell edges from "
-                   "reference edges + displacement differences (integrate.py/shell.py)")
 def test_balance_float32_no_rounding_drift():
     res, stored = _run("float32")
-    assert abs(res) < 1e-2 * stored  # measured 7.5e-2 before the fix
+    assert abs(res) < 1e-2 * stored  # measured 7.5e-2 on absolute positions, 8.8e-4 on displacements

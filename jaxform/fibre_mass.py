@@ -28,6 +28,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -155,7 +156,9 @@ def solve(units, rhs, guess, mass, free, fm: FibreMass, shell: Shell):
     p = z
     rz = jnp.sum(r * z)
     tiny = jnp.finfo(xs.dtype).tiny
-    for _ in range(fm.iters):
+
+    def iteration(_, c):
+        a, r, p, rz = c
         ap = apply(p)
         pap = jnp.sum(p * ap)
         step = jnp.where(pap > tiny, rz / jnp.maximum(pap, tiny), 0.0)
@@ -164,7 +167,10 @@ def solve(units, rhs, guess, mass, free, fm: FibreMass, shell: Shell):
         z = inv_diag * r
         rz_new = jnp.sum(r * z)
         p = z + jnp.where(rz > tiny, rz_new / jnp.maximum(rz, tiny), 0.0) * p
-        rz = rz_new
+        return a, r, p, rz_new
+
+    # a loop, not unrolled: the same speed per iteration and a compile time that does not grow with iters
+    a, r, p, rz = jax.lax.fori_loop(0, fm.iters, iteration, (a, r, p, rz))
     rel = jnp.sqrt(jnp.sum(r * r) / jnp.maximum(jnp.sum(b * b), tiny))
     return a, rel
 

@@ -10,12 +10,17 @@ Central differences with lumped mass (velocities at half steps)::
 
     a_n     = (f_int(x_n) + m g + f_loads(x_n, v_{n-1/2}, t_n) - c m v_{n-1/2}) / m
     v_{n+½} = v_{n-½} + dt a_n           (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
-    x_{n+1} = x_n + dt v_{n+½}
+    u_{n+1} = u_n + dt v_{n+½},  x_{n+1} = X + u_{n+1}
 
-Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/4 m (|v_{n-½}|² + |v_{n+½}|²)``
-(with this definition the kinetic change equals the work of the step's forces on
-``dt (v_{n-½} + v_{n+½}) / 2`` exactly); gravity work ``m g . (x_n - x_0)``; load, damping and
-boundary (reaction) work accumulated with that same displacement. The run is declared failed at the
+The integrated quantity is the displacement ``u`` from the mesh nodes ``X`` and the shell is
+evaluated on it (float32 absolute positions would add rounding noise to every strain). With a fibre
+mass (:mod:`jaxform.fibre_mass`) the division by ``m`` becomes a solve with ``M + alpha K_t``.
+
+Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/2 m |v_mid|^2`` with ``v_mid =
+(v_{n-½} + v_{n+½}) / 2`` (plus the fibre-mass part; it differs from the exactly balancing
+``1/2 m v_{n-½} . v_{n+½}`` by ``m |v_{n+½} - v_{n-½}|^2 / 8``, which stays non-negative and makes a
+chattering node show up in the balance); gravity work ``m g . (x_n - x_0)``; load, damping and
+boundary (reaction) work by the trapezoidal rule over ``x_{n-1} -> x_n``. The run is declared failed at the
 first step where a value is non-finite or the energy balance residual exceeds ``blowup_tol`` times
 the largest energy scale seen (the signature of an unstable time step).
 """
@@ -86,6 +91,9 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
     are); with a fibre mass, driven dofs must move at constant velocity (their acceleration is
     taken as zero in the solve).
     """
+    dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
+    # first: it checks the factor and iterations (a clear error before any use of them)
+    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, iters=fibre_mass_iters, dtype=dtype)
     dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
     if dt is None:
         dt = safety * dt_limit
@@ -98,14 +106,12 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
             stacklevel=2,
         )
     n = shell.mesh.n_nodes
-    dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
     x0 = jnp.asarray(shell.mesh.nodes, dtype)
     fixed = jnp.zeros((n, 3), bool) if fixed is None else jnp.asarray(fixed, bool)
     if fixed.shape != (n, 3):
         raise ValueError(f"make_model: fixed has shape {fixed.shape}: need ({n}, 3) booleans (driven dofs)")
     drive = Hold(x0) if drive is None else drive
     mass = jnp.asarray(shell.node_masses(mass_scale), dtype)
-    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, iters=fibre_mass_iters, dtype=dtype)
     return Model(shell=shell, mass=mass, fixed=fixed, drive=drive, gravity=jnp.asarray(gravity, dtype),
                  damping=jnp.asarray(damping, dtype), dt=jnp.asarray(dt, dtype), loads=tuple(loads),
                  mass_scale=mass_scale, fibre_mass=fm)

@@ -162,3 +162,7 @@ def test_case_keys_for_fibre_mass_are_checked_and_round_trip():
         cases.apply_overrides(case, ["numerics.fibre_mass_iters=0"])
     with pytest.raises(ValueError, match="factor"):
         F.fibre_mass(_shell(), float("nan"))
+    with pytest.raises(ValueError, match="factor = 0.0"):
+        make_model(_shell(), fibre_mass_factor=0.0)
+    with pytest.raises(ValueError, match="iters"):
+        make_model(_shell(), fibre_mass_factor=2.0, fibre_mass_iters=0)

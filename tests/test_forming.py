@@ -107,10 +107,10 @@ def test_gradients_of_a_short_run_match_finite_differences():
         np.testing.assert_allclose(g, fd, rtol=1e-3)
 
 
-@pytest.mark.slow
 QUASI_STATIC = ("process.speed_mm_per_s=62.5", "numerics.fibre_mass_scaling=3", "contact.safety=0.5")
 
 
+@pytest.mark.slow
 def test_quasi_static_halving_the_punch_speed_changes_little():
     """Issue 4 item 1, woven Case A (NLBM) on 8 mm elements at the quasi-static setting
     (:data:`QUASI_STATIC`: 62.5 mm/s, fibre-selective mass scaling 3): halving the speed changes

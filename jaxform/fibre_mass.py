@@ -33,7 +33,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
-from jaxform.shell import Shell, _dot, _edges, _fibres_soa, _safe_norm, membrane_frequency
+from jaxform.shell import Shell, _corner_ids, _dot, _edges, _fibres_soa, _safe_norm, membrane_frequency
 
 
 @pytree_dataclass
@@ -43,13 +43,11 @@ class FibreMass:
     Attributes:
         weight: (2, T) ``alpha A (E h)_f`` per fibre family and triangle, kg·m² (times
             ``(d lambda/dt)^2 / 2`` gives the added kinetic energy).
-        factor: the growth factor ``s`` of the membrane step limit, for reports.
         iters: static, conjugate-gradient iterations per step.
     """
 
     weight: Any
-    factor: Any
-    iters: int = static_field(default=10)
+    iters: int = static_field()
 
 
 def default_iters(factor: float) -> int:
@@ -82,7 +80,7 @@ def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, iters: int | None
         alpha = (factor**2 - 1.0) / wm**2
         eh = np.broadcast_to(np.asarray(fab.fibre_modulus, np.float64) * float(np.asarray(fab.thickness)), (2,))
         w[:, t0:t1] = alpha * area[None, t0:t1] * eh[:, None]
-    return FibreMass(weight=jnp.asarray(w, dtype), factor=factor, iters=int(iters))
+    return FibreMass(weight=jnp.asarray(w, dtype), iters=int(iters))
 
 
 def fibre_units(xs, shell: Shell):
@@ -107,9 +105,7 @@ def _corners(q1, q2, coef):
 
 
 def _assemble(corners, mesh, like):
-    t = mesh.tris
-    ids = jnp.concatenate([t[:, 0], t[:, 1], t[:, 2]])
-    return jnp.zeros_like(like).at[:, ids].add(jnp.concatenate(corners, axis=1))
+    return jnp.zeros_like(like).at[:, _corner_ids(mesh)].add(jnp.concatenate(corners, axis=1))
 
 
 def added_mass_times(ps, units, fm: FibreMass, shell: Shell):

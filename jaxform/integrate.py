@@ -26,6 +26,7 @@ the largest energy scale seen (the signature of an unstable time step).
 """
 from __future__ import annotations
 
+import dataclasses
 import warnings
 from typing import Any
 
@@ -235,9 +236,7 @@ def _freeze_if_failed(start: State, end: State) -> State:
     with ``end``'s step count and failure record."""
     keep = end.bad_step >= 0  # a failure record, once set, is never cleared
     frozen = jax.tree_util.tree_map(lambda a, b: jnp.where(keep, a, b), start, end)
-    return State(x=frozen.x, v=frozen.v, t=frozen.t, step=end.step, energies=frozen.energies,
-                 loads=frozen.loads, f_prev=frozen.f_prev, bad_step=end.bad_step, bad_code=end.bad_code,
-                 scale_max=frozen.scale_max, acc=frozen.acc, solve_residual=frozen.solve_residual, u=frozen.u)
+    return dataclasses.replace(frozen, step=end.step, bad_step=end.bad_step, bad_code=end.bad_code)
 
 
 def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None, x_ref=None,

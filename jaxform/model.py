@@ -159,9 +159,9 @@ class State:
     bad_step: Any
     bad_code: Any
     scale_max: Any
-    acc: Any = None
-    solve_residual: Any = None
-    u: Any = None
+    acc: Any
+    solve_residual: Any
+    u: Any
 
 
 __all__ = ["Model", "State", "Energies", "Hold", "LinearDrive"]

@@ -63,7 +63,7 @@ class ShellRef:
         kappa0: (N, 2) reference fibre curvature, 1/m (zero for a flat blank).
         edge0: (2, 3, T) reference edge vectors ``x1 - x0``, ``x2 - x0`` of every triangle, m.
         deriv0: (5, 3, N) reference node derivatives ``X_X .. X_YY`` (the stencil on the mesh).
-            With these, the kernel can take displacements (``*_disp``): the edges and derivatives
+            With these, the kernel can take displacements (``displacement=True``): the edges and derivatives
             are then ``reference + linear(u)``, free of the rounding of absolute positions (in
             float32 a 0.1 m coordinate is rounded to 7e-9 m, a strain noise of 1e-6 on 8 mm
             edges every step, which heats the stiff fibre modes of a long explicit run).
@@ -75,8 +75,8 @@ class ShellRef:
     theta0: Any
     node_dir: Any
     kappa0: Any
-    edge0: Any = None
-    deriv0: Any = None
+    edge0: Any
+    deriv0: Any
 
 
 def shell_reference(mesh: Mesh, fibre_angles) -> ShellRef:
@@ -138,6 +138,13 @@ def _safe_norm(v):
 
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on
 # CPU, where (n, 3) layouts with tiny trailing axes do not (measured: 5-10x).
+
+
+def _corner_ids(mesh: Mesh):
+    """(3T,) node of every triangle corner, corner-major: the scatter indices of per-corner values
+    laid out as ``concatenate([c0, c1, c2], axis=1)``."""
+    t = mesh.tris
+    return jnp.concatenate([t[:, 0], t[:, 1], t[:, 2]])
 
 
 def _edges(xs, mesh: Mesh, base=None):
@@ -388,8 +395,7 @@ def forces_and_energy_soa(xs, shell: Shell, weights=None, displacement: bool = F
     argnums = (0, 1, 2) if has_b else (0, 1)
     (_, parts), grads = jax.value_and_grad(_local_energy, argnums=argnums, has_aux=True)(e1, e2, D, shell, weights)
     g1, g2 = grads[0], grads[1]
-    t = mesh.tris
-    ids = jnp.concatenate([t[:, 0], t[:, 1], t[:, 2]])
+    ids = _corner_ids(mesh)
     vals = jnp.concatenate([-(g1 + g2), g1, g2], axis=1)  # dE/dx of the corners (3, 3T)
     if has_b:
         H = _derivs_transpose(grads[2], mesh)  # (3, K, N) dE/d(x_nbr_k - x_i)
@@ -406,8 +412,8 @@ def forces_and_energy_sym(us, shell: Shell):
     """:func:`forces_and_energy_soa` on displacements ``us = x - X`` (3, N) whose reverse mode
     uses the symmetry of the Hessian.
 
-    Same values as ``forces_and_energy_soa(us, shell, displacement=True)``. Cotangents ``(r, c)`` of the forces (3, N) and of the energy parts give
-    ``x_bar = -H r + grad(sum_k c_k E_k)`` with ``-H r`` taken as the *forward* derivative of the
+    Same values as ``forces_and_energy_soa(us, shell, displacement=True)``. Cotangents ``(r, c)``
+    of the forces (3, N) and of the energy parts give ``u_bar = -H r + grad(sum_k c_k E_k)`` with ``-H r`` taken as the *forward* derivative of the
     forces along ``r`` (``-H`` is symmetric), and ``shell_bar = d/dshell(-grad E . r + sum_k c_k E_k)``.
     Plain reverse mode would transpose every gather of the kernel into a scatter (slow on CPU);
     this way the backward pass has the forward pass's structure. Reverse mode only (no ``jvp``):
@@ -421,19 +427,19 @@ def _sym_fwd(us, shell):
 
 
 def _sym_bwd(res, ct):
-    xs, shell = res
+    us, shell = res
     r, c = ct
     c = (c["tension"], c["shear"], c["bending"])
     # -H r: the forward derivative of the forces along r; sum_k c_k grad E_k: the forces of the
     # c-weighted energy (same kernel and assembly as the forward pass, no transposed gathers)
-    _, f_r = jax.jvp(lambda y: forces_and_energy_soa(y, shell, displacement=True)[0], (xs,), (r,))
-    f_c = forces_and_energy_soa(xs, shell, weights=c, displacement=True)[0]
+    _, f_r = jax.jvp(lambda y: forces_and_energy_soa(y, shell, displacement=True)[0], (us,), (r,))
+    f_c = forces_and_energy_soa(us, shell, weights=c, displacement=True)[0]
 
     def phi(sh):
-        parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh, displacement=True), (xs,), (r,))
+        parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh, displacement=True), (us,), (r,))
         return sum(ck * parts[k] - dparts[k] for ck, k in zip(c, ("tension", "shear", "bending")))
 
-    (shell_bar,) = jax.vjp(phi, shell)[1](jnp.ones((), xs.dtype))
+    (shell_bar,) = jax.vjp(phi, shell)[1](jnp.ones((), us.dtype))
     return f_r - f_c, shell_bar
 
 

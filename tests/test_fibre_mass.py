@@ -74,7 +74,7 @@ def _largest_frequency(shell, fm):
     x0 = jnp.asarray(shell.mesh.nodes)
     mass = shell.node_masses()
     units = F.fibre_units(x0.T, shell)
-    exact = F.FibreMass(weight=fm.weight, factor=fm.factor, iters=200) if fm is not None else None
+    exact = F.FibreMass(weight=fm.weight, iters=200) if fm is not None else None
 
     @jax.jit
     def apply(u):

@@ -20,7 +20,11 @@ Numerics (documented choices):
 * time step: ``dt_safety`` (0.75) times the shell's stable estimate, rounded down so that a whole
   number of steps fills each frame interval;
 * gravity ``-9.81 m/s²`` along z, divided by the mass scaling so the physical weight is kept;
-* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed;
+* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed, raised
+  under high pressure so that explicit stick stays stable (:mod:`jaxform.contact`);
+* optional fibre-selective mass scaling ``numerics.fibre_mass_scaling`` (:mod:`jaxform.fibre_mass`):
+  the step's membrane limit grows by that factor (the contact cap then usually needs a larger
+  ``contact.safety``);
 * Case B holder: mass ``holder.mass_kg``, critically damped on its contact stiffness.
 
 Quasi-static check (issue 4 item 1; woven Case A, NLBM, 8 mm elements, float32): at the preset

@@ -7,9 +7,7 @@
   25.8 mm at the edge mid-sides, ~6 mm at the corners, max shear 49°, flange lifted, no discrete
   wrinkles; 429 s on one core, 277 s on two).
 * ``openradioss_setup_fibre_mass``: the same with fibre-selective mass scaling (``FIBRE_MASS_4MM``).
-* ``case_a_2mm``: per-step time of woven Case A at 2 mm (NLBM, LBM, membrane) after compilation,
-  and the full-stroke wall time it implies (steps x per-step + compile); NLBM's overhead over LBM;
-  NLBM with fibre-selective mass scaling (``FIBRE_MASS_2MM``).
+* woven Case A at 2 mm: see ``bench_forming_2mm.py`` (``run.py --only forming_2mm``).
 * ``step_split_ms``: ms per step of woven Case A at 4 and 2 mm split into shell forces, tool
   contact and the rest (integrator, energies).
 * ``quasi_static``: the same coarse run at the preset punch speed and at half of it: change of
@@ -30,7 +28,7 @@ import numpy as np
 COARSE_MM = 8.0
 # fibre-selective mass scaling (jaxform.fibre_mass) with the contact safety that lets the step grow
 FIBRE_MASS_4MM = ("numerics.fibre_mass_scaling=7", "contact.safety=0.9")
-FIBRE_MASS_2MM = ("numerics.fibre_mass_scaling=10", "contact.safety=0.5")
+FIBRE_MASS_2MM = ("numerics.fibre_mass_scaling=12", "contact.safety=0.5")
 
 
 def _case(name, size_mm, *overrides):
@@ -174,13 +172,6 @@ def run(quick: bool = False) -> dict:
     ncf = forming.simulate(_case("case-a-ncf-nlbm", COARSE_MM))
     out["coarse_ncf_nlbm"] = _figures(ncf)
     _log("coarse_ncf_nlbm", out["coarse_ncf_nlbm"])
-    # item 7: 2 mm per-step cost (full runs take hours on a loaded 2-core machine)
-    out["case_a_2mm"] = {b: _per_step(f"case-a-woven-{b}", 2.0) for b in ("nlbm", "lbm-41", "membrane")}
-    c2 = out["case_a_2mm"]
-    c2["nlbm_overhead_over_lbm"] = c2["nlbm"]["per_step_s"] / c2["lbm-41"]["per_step_s"] - 1.0
-    c2["nlbm_fibre_mass"] = _per_step("case-a-woven-nlbm", 2.0, *FIBRE_MASS_2MM)
-    c2["nlbm_fibre_mass"]["overrides"] = list(FIBRE_MASS_2MM)
-    _log("case_a_2mm", c2)
     out["step_split_ms"] = {f"{mm:g}mm": _step_split("case-a-woven-nlbm", mm) for mm in (4.0, 2.0)}
     _log("step_split_ms", out["step_split_ms"])
     # item 7: the OpenRadioss comparison setup

@@ -24,8 +24,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(load("case-a-wove
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety, slip_velocity_fraction,
                damping_ratio
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling (>= 1,
-               default 1 = off: inertia added to fibre stretching only, see jaxform.fibre_mass)
-               and fibre_mass_iters (conjugate-gradient iterations per step, default ceil(2 s))
+               default 1 = off: inertia added to fibre stretching only, the membrane limit of
+               the step grows by that factor; see jaxform.fibre_mass)
 
 This module reads no files: :func:`load` takes the text of a TOML file through
 :func:`jaxform.io.case_file.read_case` only when given a path.
@@ -131,7 +131,6 @@ class Case:
     dtype: str
     mass_scaling: float
     fibre_mass_scaling: float = 1.0
-    fibre_mass_iters: int | None = None
 
     @property
     def n_plies(self) -> int:
@@ -178,8 +177,7 @@ _SCHEMA: dict[str, dict[str, tuple]] = {
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("float", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True)},
-    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("float", False),
-                 "fibre_mass_iters": ("int", False)},
+    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("float", False)},
 }
 _VOCE_KEYS = ("b_inf_Nm", "m0_N", "kappa0_per_m")
 
@@ -357,16 +355,13 @@ def _build(d) -> Case:
     fms = n.get("fibre_mass_scaling", 1.0)
     if not (math.isfinite(fms) and fms >= 1.0):
         raise _err("numerics.fibre_mass_scaling", fms, "must be a number >= 1 (1 = off)")
-    fmi = n.get("fibre_mass_iters")
-    if fmi is not None and fmi < 1:
-        raise _err("numerics.fibre_mass_iters", fmi, "must be >= 1")
 
     orient = tuple(math.radians(a) for a in d["plies"]["orientations_deg"])
     case = Case(
         name=d[""]["name"], description=d[""].get("description", ""), fabric=fabric, orientations=orient,
         blank_size=d["blank"]["size_mm"] * _MM, element_size=d["blank"]["element_size_mm"] * _MM,
         tools=tools_spec, holder=holder, process=process, contact=contact_spec,
-        dtype=n["dtype"], mass_scaling=n["mass_scaling"], fibre_mass_scaling=fms, fibre_mass_iters=fmi,
+        dtype=n["dtype"], mass_scaling=n["mass_scaling"], fibre_mass_scaling=fms,
     )
     _check_setup(case)
     return case
@@ -441,8 +436,6 @@ def to_dict(case: Case) -> dict:
         holder["mass_kg"] = h.mass
     p, c = case.process, case.contact
     numerics = {"dtype": case.dtype, "mass_scaling": case.mass_scaling, "fibre_mass_scaling": case.fibre_mass_scaling}
-    if case.fibre_mass_iters is not None:
-        numerics["fibre_mass_iters"] = case.fibre_mass_iters
     return {
         "name": case.name,
         "description": case.description,

@@ -37,9 +37,9 @@ stiffness, so its inertia matters down to slow punch speeds. Not the cause: the 
 regularisation (0.1°), float32 vs float64 (0.14°); mass damping (50 1/s) drags the draw-in (-3%)
 without closing the gap. Uniform mass scaling ``s`` at speed ``v`` is exactly the run at speed
 ``v sqrt(s)``, so it buys nothing here. What works: 62.5 mm/s against 31.25 mm/s changes the map
-by 0.46° (p95) and the draw-in by 0.24%, with fibre-selective mass scaling 3
-(``numerics.fibre_mass_scaling``, which leaves the flange's inertia alone; against the unscaled
-62.5 mm/s run: 0.53°, draw-in 1.1%) and ``contact.safety = 0.5``: 153k steps, 204 s on one core.
+by 0.51° (p95) and the draw-in by 0.23%, with fibre-selective mass scaling 3
+(``numerics.fibre_mass_scaling``, which leaves the flange's inertia alone) and
+``contact.safety = 0.5``: 153k steps, 118 s on one core (the 31.25 mm/s run: 232 s).
 """
 from __future__ import annotations
 
@@ -263,7 +263,7 @@ def build(case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
 
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -GRAVITY / ms), loads=tuple(loads), dtype=jdtype,
-                                 fibre_mass_factor=fms, fibre_mass_iters=case.fibre_mass_iters)
+                                 fibre_mass_factor=fms)
     x0 = jnp.asarray(mesh.nodes, jdtype)
     load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
     # jitted: eager (op-by-op) evaluation of the shell forces costs seconds

@@ -14,14 +14,16 @@ Central differences with lumped mass (velocities at half steps)::
 
 The integrated quantity is the displacement ``u`` from the mesh nodes ``X`` and the shell is
 evaluated on it (float32 absolute positions would add rounding noise to every strain). With a fibre
-mass (:mod:`jaxform.fibre_mass`) the division by ``m`` becomes a solve with ``M + alpha K_t``.
+mass (:mod:`jaxform.fibre_mass`) the free dofs carry the momentum ``p``: ``p_{n+½} = p_{n-½} + dt f_n``,
+``v_{n+½} = C(x_n) p_{n+½}`` with ``C`` the polynomial inverse mass (the same scheme as above while
+``C`` stays ``M^-1``).
 
 Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/2 m |v_mid|^2`` with ``v_mid =
-(v_{n-½} + v_{n+½}) / 2`` (plus the fibre-mass part; it differs from the exactly balancing
-``1/2 m v_{n-½} . v_{n+½}`` by ``m |v_{n+½} - v_{n-½}|^2 / 8``, which stays non-negative and makes a
-chattering node show up in the balance); gravity work ``m g . (x_n - x_0)``; load, damping and
-boundary (reaction) work by the trapezoidal rule over ``x_{n-1} -> x_n``. The run is declared failed at the
-first step where a value is non-finite or the energy balance residual exceeds ``blowup_tol`` times
+(v_{n-½} + v_{n+½}) / 2`` (with a fibre mass ``1/2 v_mid . p_mid``: the same with the mass
+``C^-1``; it differs from the exactly balancing ``1/2 m v_{n-½} . v_{n+½}`` by
+``m |v_{n+½} - v_{n-½}|^2 / 8``, which stays non-negative and makes a chattering node show up in
+the balance); gravity work ``m g . (x_n - x_0)``; load, damping and boundary (reaction) work by
+the trapezoidal rule over ``x_{n-1} -> x_n``. The run is declared failed at the first step where a value is non-finite or the energy balance residual exceeds ``blowup_tol`` times
 the largest energy scale seen (the signature of an unstable time step).
 """
 from __future__ import annotations
@@ -80,21 +82,20 @@ class Frames:
 
 def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, mass_scale: float = 1.0,
                damping: float = 0.0, gravity=(0.0, 0.0, 0.0), fixed=None, drive=None, loads: tuple = (),
-               dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_iters: int | None = None) -> Model:
+               dtype=None, fibre_mass_factor: float = 1.0) -> Model:
     """Build a :class:`Model` on the host.
 
     ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.shell.stable_time_step`);
     a user ``dt`` above the limit is kept but warned about. ``mass_scale`` multiplies all masses
     (raising the stable step by its square root). ``fibre_mass_factor`` ``s`` > 1 adds inertia to
-    fibre stretching only (:mod:`jaxform.fibre_mass`; the membrane limit grows by ``s``, solved
-    with ``fibre_mass_iters`` conjugate-gradient iterations per step). ``fixed`` (N, 3) bool
-    marks driven dofs (default none), ``drive`` gives their positions (default: held where they
-    are); with a fibre mass, driven dofs must move at constant velocity (their acceleration is
-    taken as zero in the solve).
+    fibre stretching only (:mod:`jaxform.fibre_mass`; the membrane limit grows by ``s``). ``fixed``
+    (N, 3) bool marks driven dofs (default none), ``drive`` gives their positions (default: held
+    where they are); with a fibre mass, the added inertia couples free dofs only (a driven dof's
+    motion does not load its free neighbours through it).
     """
     dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
-    # first: it checks the factor and iterations (a clear error before any use of them)
-    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, iters=fibre_mass_iters, dtype=dtype)
+    # first: it checks the factor (a clear error before any use of it)
+    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, dtype=dtype)
     dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
     if dt is None:
         dt = safety * dt_limit
@@ -121,7 +122,8 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
 def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -> State:
     """The state at t = 0: positions ``x`` (default: the reference), velocities ``v`` (default 0).
 
-    ``v`` is the velocity at t = 0; the kinetic energy account starts from it.
+    ``v`` is the velocity at t = 0; the kinetic energy account starts from it. With a fibre mass
+    it is taken to stretch no fibre (rest, a rigid motion): its momentum is ``M v``.
     """
     dtype = model.mass.dtype
     x = jnp.asarray(model.shell.mesh.nodes if x is None else x, dtype)
@@ -129,16 +131,14 @@ def init_state(model: Model, x=None, v=None, load_states: tuple | None = None) -
     u = (x - jnp.asarray(model.shell.mesh.nodes, dtype)).T
     _, parts = forces_and_energy_sym(u, model.shell)
     ke = 0.5 * jnp.sum(model.mass[:, None] * v * v)
-    if model.fibre_mass is not None:
-        ke = ke + _fm.added_kinetic_energy(v.T, _fm.fibre_units(x.T, model.shell), model.fibre_mass, model.shell)
     z = jnp.zeros((), dtype)
     e = Energies(ke, parts["tension"], parts["shear"], parts["bending"], z, z, z, z)
     loads = tuple(None for _ in model.loads) if load_states is None else tuple(load_states)
     zero = jnp.zeros_like(x.T)  # SoA (3, N), as the step keeps them
     return State(x=x, v=v, t=jnp.zeros((), dtype), step=jnp.zeros((), jnp.int32), energies=e, loads=loads,
                  f_prev=(zero, zero, zero), bad_step=jnp.asarray(-1, jnp.int32),
-                 bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale(), acc=zero,
-                 solve_residual=jnp.zeros((), dtype), u=u)
+                 bad_code=jnp.asarray(0, jnp.int32), scale_max=e.scale(),
+                 momentum=jnp.where(model.fixed, 0.0, model.mass[:, None] * v).T, u=u)
 
 
 def _step(model: Model, state: State, x_ref):
@@ -167,12 +167,12 @@ def _step(model: Model, state: State, x_ref):
     fixed = model.fixed.T
     fm = model.fibre_mass
     if fm is None:
-        acc, resid = f_free / m, jnp.zeros((), xs.dtype)
+        p_new = state.momentum
+        v_free = vs_old + h * f_free / m
     else:
-        units = _fm.fibre_units(xs, model.shell)
-        acc, resid = _fm.solve(units, f_free, state.acc, model.mass, jnp.where(fixed, 0.0, 1.0).astype(xs.dtype),
-                               fm, model.shell)
-    v_free = vs_old + h * acc
+        free = jnp.where(fixed, 0.0, 1.0).astype(xs.dtype)
+        p_new = free * (state.momentum + h * f_free)
+        v_free = _fm.inverse_mass_times(p_new, _fm.fibre_units(xs, model.shell), model.mass, free, fm, model.shell)
     x_drive = model.drive.position(t + dt).T
     v_drive = (x_drive - xs) / dt
     v_new = jnp.where(fixed, v_drive, v_free)
@@ -185,9 +185,11 @@ def _step(model: Model, state: State, x_ref):
     dx = jnp.where(first, 0.0, dt * vs_old)
     fl0, fd0, fr0 = state.f_prev
     e_old = state.energies
-    kinetic = 0.5 * jnp.sum(m * v_mid * v_mid)
-    if fm is not None:
-        kinetic = kinetic + _fm.added_kinetic_energy(v_mid, units, fm, model.shell)
+    if fm is None:
+        kinetic = 0.5 * jnp.sum(m * v_mid * v_mid)
+    else:  # 1/2 v_mid . C^-1 v_mid with C^-1 v = p on the free dofs, the lumped mass on the driven ones
+        p_mid = jnp.where(first, state.momentum, 0.5 * (state.momentum + p_new))
+        kinetic = 0.5 * jnp.sum(v_mid * jnp.where(fixed, m * v_mid, p_mid))
     e = Energies(
         kinetic=kinetic,
         tension=parts["tension"],
@@ -198,7 +200,7 @@ def _step(model: Model, state: State, x_ref):
         boundary_work=e_old.boundary_work + 0.5 * jnp.sum((fr0 + reaction) * dx),
         damping_work=e_old.damping_work - 0.5 * jnp.sum((fd0 + f_damp) * dx),
     )
-    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (acc, resid, u_new)
+    return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (p_new, u_new)
 
 
 def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
@@ -216,7 +218,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     reverts a failed stretch to its start, :func:`_freeze_if_failed`): a per-step select of the
     whole state costs as much as the forces on CPU (it defeats XLA's in-place buffer reuse).
     """
-    x_new, v_new, e, loads, extras, fp, (acc, resid, u_new) = _step(model, state, x_ref)
+    x_new, v_new, e, loads, extras, fp, (p_new, u_new) = _step(model, state, x_ref)
     # every node's position and velocity enters the energies: one non-finite value makes them so
     finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
@@ -227,7 +229,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
                 f_prev=fp, bad_step=jnp.where(fail_now, state.step, state.bad_step),
                 bad_code=jnp.where(fail_now, code, state.bad_code), scale_max=jnp.where(finite, scale, state.scale_max),
-                acc=acc, solve_residual=resid, u=u_new)
+                momentum=p_new, u=u_new)
     return new, extras
 
 

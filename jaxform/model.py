@@ -142,9 +142,9 @@ class State:
         bad_step: -1 while the run is healthy, else the first step that failed (run is frozen).
         bad_code: 0 ok, 1 non-finite values, 2 energy blow-up.
         scale_max: the largest energy scale seen, J.
-        acc: (3, N) accelerations of the last step (SoA), m/s² (the warm start of the
-            fibre-mass solve).
-        solve_residual: relative residual of the last fibre-mass solve (0 without it).
+        momentum: (3, N) momenta of the free dofs at the previous half step (SoA), kg·m/s: the
+            integrated quantity with a fibre mass (:mod:`jaxform.fibre_mass`; ``v = C p``),
+            else ``M v`` at the start (unused).
         u: (3, N) displacements from the mesh nodes (SoA), m: the integrated quantity (``x`` is
             ``X + u``; the shell is evaluated on ``u``, see :class:`~jaxform.shell.ShellRef`).
     """
@@ -159,8 +159,7 @@ class State:
     bad_step: Any
     bad_code: Any
     scale_max: Any
-    acc: Any
-    solve_residual: Any
+    momentum: Any
     u: Any
 
 

@@ -115,9 +115,9 @@ def test_quasi_static_halving_the_punch_speed_changes_little():
     """Issue 4 item 1, woven Case A (NLBM) on 8 mm elements at the quasi-static setting
     (:data:`QUASI_STATIC`: 62.5 mm/s, fibre-selective mass scaling 3): halving the speed changes
     the edge draw-in by < 2% and the shear-angle map by < 1 deg at the 95th percentile of all
-    nodes (flange included). Measured: 0.24% and 0.46 deg (125 vs 62.5 mm/s: 1.21 deg; at the
-    preset 500 mm/s: 2.3 deg, the unclamped flange's buckling events lag the punch by inertia).
-    About 10 minutes on one core."""
+    nodes (flange included). Measured: 0.23% and 0.51 deg (125 vs 62.5 mm/s, with the former
+    solve-based fibre mass: 1.21 deg; at the preset 500 mm/s: 2.3 deg, the unclamped flange's
+    buckling events lag the punch by inertia). About 6 minutes on one core."""
     case = cases.apply_overrides(_coarse("case-a-woven-nlbm", size_mm=8.0), list(QUASI_STATIC))
     half = cases.apply_overrides(case, [f"process.speed_mm_per_s={0.5 * case.process.speed * 1e3!r}"])
     runs = [forming.simulate(c) for c in (case, half)]

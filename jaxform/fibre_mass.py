@@ -37,7 +37,8 @@ construction as Runge-Kutta-Chebyshev stability polynomials), normalised to ``q(
 Cost: ``n - 1`` products with ``K_t`` per step (gathers, a few multiply-adds, a scatter), no
 reductions, no convergence test, fixed shapes; differentiable as any other loop of ``jit`` code.
 (A Jacobi-preconditioned conjugate-gradient solve with ``M + alpha K_t`` needed about ``2 s``
-iterations of a dearer kind for the same factor: 28 ms/step against 19 ms on the 2 mm hemisphere.)
+iterations of a dearer kind, warm starts did not help: 28 ms/step at ``s = 10`` against 19 ms
+with this polynomial, 2 mm hemisphere, two cores.)
 
 The integrator carries the momentum ``p = C^-1 v`` of the free dofs: ``p += dt f``, ``v = C p``,
 so the kinetic energy ``1/2 p . v`` is exact without inverting ``C``. ``C`` follows the fibre

@@ -666,7 +666,10 @@ def summarize(result: FormingResult) -> dict:
         "numerics": {"dt_s": info.dt, "stable_dt_s": info.stable_dt, "n_steps": info.n_steps,
                      "steps_done": int(h["step"][-1]) if len(h["step"]) else 0, "stroke_time_s": T,
                      "nodes": int(len(info.x0)), "mass_scaling": float(case.mass_scaling),
-                     "fibre_mass_scaling": float(case.fibre_mass_scaling), "dtype": case.dtype,
+                     "fibre_mass_scaling": float(case.fibre_mass_scaling),
+                     # products with the fibre-tension stiffness per step: degree - 1
+                     "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
+                     "dtype": case.dtype,
                      "punch_speed_m_per_s": float(case.process.speed)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,

@@ -112,6 +112,11 @@ def peak(n: int) -> float:
     return 1.001 * n**2 * float(np.max(y * _q(y, n, theta, a, b))) / q0
 
 
+def _tension_stiffness(fab):
+    """``(E h)_f`` (2,) of a ply's two fibre families, N/m (host, float64)."""
+    return np.broadcast_to(np.asarray(fab.fibre_modulus, np.float64) * float(np.asarray(fab.thickness)), (2,))
+
+
 def spectral_bound(shell: Shell, mass_scale=1.0) -> list:
     """Per ply, an upper bound ``X`` of the eigenvalues of ``M^-1 K_t``, 1/s² (host, float64).
 
@@ -127,7 +132,7 @@ def spectral_bound(shell: Shell, mass_scale=1.0) -> list:
     area = np.asarray(shell.ref.tri_area, np.float64)
     out = []
     for (t0, t1), fab in zip(mesh.ply_tris, shell.fabrics):
-        eh = np.broadcast_to(np.asarray(fab.fibre_modulus, np.float64) * float(np.asarray(fab.thickness)), (2,))
+        eh = _tension_stiffness(fab)
         t = tris[t0:t1]
         row = np.zeros(len(m))
         for f in range(2):
@@ -161,7 +166,7 @@ def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, dtype=jnp.float32
     area = np.asarray(shell.ref.tri_area, np.float64)
     w = np.zeros((2, len(area)))
     for (t0, t1), fab, x in zip(shell.mesh.ply_tris, shell.fabrics, bounds):
-        eh = np.broadcast_to(np.asarray(fab.fibre_modulus, np.float64) * float(np.asarray(fab.thickness)), (2,))
+        eh = _tension_stiffness(fab)
         w[:, t0:t1] = area[None, t0:t1] * eh[:, None] / x
     return FibreMass(weight=jnp.asarray(w, dtype), degree=n)
 

@@ -41,7 +41,7 @@ iterations of a dearer kind, warm starts did not help: 28 ms/step at ``s = 10`` 
 with this polynomial, 2 mm hemisphere, two cores.)
 
 The integrator carries the momentum ``p = C^-1 v`` of the free dofs: ``p += dt f``, ``v = C p``,
-so the kinetic energy ``1/2 p . v`` is exact without inverting ``C``. ``C`` follows the fibre
+so the kinetic energy ``1/2 v . p`` needs no inverse of ``C``. ``C`` follows the fibre
 directions at the step's positions; the velocity follows the momentum, as for any
 position-dependent mass.
 """

@@ -6,25 +6,25 @@ that reverse mode through thousands of steps stores only the frames (memory ~ fr
 :func:`simulate` is the host-side driver: it jits the rollout, checks the run's health and raises
 :class:`SimulationError` (with the frames up to the last good one) when it failed.
 
-Central differences with lumped mass (velocities at half steps)::
+Central differences (velocities at half steps), the free dofs carrying the momentum ``p``::
 
-    a_n     = (f_int(x_n) + m g + f_loads(x_n, v_{n-1/2}, t_n) - c m v_{n-1/2}) / m
-    v_{n+½} = v_{n-½} + dt a_n           (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
-    u_{n+1} = u_n + dt v_{n+½},  x_{n+1} = X + u_{n+1}
+    f_n     = f_int(x_n) + m g + f_loads(x_n, v_{n-1/2}, t_n) - c m v_{n-1/2}
+    p_{n+½} = p_{n-½} + dt f_n,   v_{n+½} = C p_{n+½}   (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
+    u_{n+1} = u_n + dt v_{n+½},   x_{n+1} = X + u_{n+1}
 
-The integrated quantity is the displacement ``u`` from the mesh nodes ``X`` and the shell is
-evaluated on it (float32 absolute positions would add rounding noise to every strain). With a fibre
-mass (:mod:`jaxform.fibre_mass`) the free dofs carry the momentum ``p``: ``p_{n+½} = p_{n-½} + dt f_n``,
-``v_{n+½} = C(x_n) p_{n+½}`` with ``C`` the polynomial inverse mass (the same scheme as above while
-``C`` stays ``M^-1``).
+``C`` is the inverse mass: ``M^-1`` (lumped), or with a fibre mass (:mod:`jaxform.fibre_mass`)
+the polynomial ``C(x_n)``. The integrated quantity is the displacement ``u`` from the mesh nodes
+``X`` and the shell is evaluated on it (float32 absolute positions would add rounding noise to
+every strain).
 
-Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/2 m |v_mid|^2`` with ``v_mid =
-(v_{n-½} + v_{n+½}) / 2`` (with a fibre mass ``1/2 v_mid . p_mid``: the same with the mass
-``C^-1``; it differs from the exactly balancing ``1/2 m v_{n-½} . v_{n+½}`` by
-``m |v_{n+½} - v_{n-½}|^2 / 8``, which stays non-negative and makes a chattering node show up in
-the balance); gravity work ``m g . (x_n - x_0)``; load, damping and boundary (reaction) work by
-the trapezoidal rule over ``x_{n-1} -> x_n``. The run is declared failed at the first step where a value is non-finite or the energy balance residual exceeds ``blowup_tol`` times
-the largest energy scale seen (the signature of an unstable time step).
+Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/2 v_mid . p_mid`` with ``v_mid =
+(v_{n-½} + v_{n+½}) / 2`` (``1/2 m |v_mid|^2`` with the lumped mass; it differs from the exactly
+balancing ``1/2 m v_{n-½} . v_{n+½}`` by ``m |v_{n+½} - v_{n-½}|^2 / 8``, which stays non-negative
+and makes a chattering node show up in the balance); gravity work ``m g . (x_n - x_0)``; load,
+damping and boundary (reaction) work by the trapezoidal rule over ``x_{n-1} -> x_n``. The run is
+declared failed at the first step where a value is non-finite or the energy balance residual
+exceeds ``blowup_tol`` times the largest energy scale seen (the signature of an unstable time
+step).
 """
 from __future__ import annotations
 
@@ -166,12 +166,11 @@ def _step(model: Model, state: State, x_ref):
     h = jnp.where(first, 0.5 * dt, dt)
     fixed = model.fixed.T
     fm = model.fibre_mass
+    free = jnp.where(fixed, 0.0, 1.0).astype(xs.dtype)
+    p_new = free * (state.momentum + h * f_free)
     if fm is None:
-        p_new = state.momentum
-        v_free = vs_old + h * f_free / m
+        v_free = p_new / m
     else:
-        free = jnp.where(fixed, 0.0, 1.0).astype(xs.dtype)
-        p_new = free * (state.momentum + h * f_free)
         v_free = _fm.inverse_mass_times(p_new, _fm.fibre_units(xs, model.shell), model.mass, free, fm, model.shell)
     x_drive = model.drive.position(t + dt).T
     v_drive = (x_drive - xs) / dt
@@ -185,11 +184,9 @@ def _step(model: Model, state: State, x_ref):
     dx = jnp.where(first, 0.0, dt * vs_old)
     fl0, fd0, fr0 = state.f_prev
     e_old = state.energies
-    if fm is None:
-        kinetic = 0.5 * jnp.sum(m * v_mid * v_mid)
-    else:  # 1/2 v_mid . C^-1 v_mid with C^-1 v = p on the free dofs, the lumped mass on the driven ones
-        p_mid = jnp.where(first, state.momentum, 0.5 * (state.momentum + p_new))
-        kinetic = 0.5 * jnp.sum(v_mid * jnp.where(fixed, m * v_mid, p_mid))
+    # 1/2 v_mid . C^-1 v_mid with C^-1 v = p on the free dofs, the lumped mass on the driven ones
+    p_mid = jnp.where(first, state.momentum, 0.5 * (state.momentum + p_new))
+    kinetic = 0.5 * jnp.sum(v_mid * jnp.where(fixed, m * v_mid, p_mid))
     e = Energies(
         kinetic=kinetic,
         tension=parts["tension"],

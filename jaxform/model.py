@@ -142,9 +142,9 @@ class State:
         bad_step: -1 while the run is healthy, else the first step that failed (run is frozen).
         bad_code: 0 ok, 1 non-finite values, 2 energy blow-up.
         scale_max: the largest energy scale seen, J.
-        momentum: (3, N) momenta of the free dofs at the previous half step (SoA), kg·m/s: the
-            integrated quantity with a fibre mass (:mod:`jaxform.fibre_mass`; ``v = C p``),
-            else ``M v`` at the start (unused).
+        momentum: (3, N) momenta of the free dofs at the previous half step (SoA), kg·m/s (0 on
+            driven dofs): the integrated quantity, ``v = C p`` with ``C`` the inverse mass
+            (``M^-1``, or the fibre mass of :mod:`jaxform.fibre_mass`).
         u: (3, N) displacements from the mesh nodes (SoA), m: the integrated quantity (``x`` is
             ``X + u``; the shell is evaluated on ``u``, see :class:`~jaxform.shell.ShellRef`).
     """

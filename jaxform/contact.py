@@ -44,7 +44,6 @@ the same central-difference (leapfrog) scheme as the fabric.
 """
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import jax

@@ -53,7 +53,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform import cases as _cases
-from jaxform import contact, integrate, tools
+from jaxform import contact, integrate
 from jaxform.mesh import Mesh
 from jaxform.shell import Shell, fibre_curvatures, fibre_vectors, shear_angle, stable_time_step
 

@@ -70,7 +70,7 @@ class Model:
         loads: tuple of external loads (see the module docstring).
         mass_scale: the factor applied to the physical masses (1 = none), for reports.
         fibre_mass: ``None`` or a :class:`~jaxform.fibre_mass.FibreMass`: inertia added to fibre
-            stretching only (accelerations then come from a linear solve each step).
+            stretching only (the inverse mass becomes a polynomial in the fibre stiffness).
     """
 
     shell: Shell

@@ -63,10 +63,11 @@ class ShellRef:
         kappa0: (N, 2) reference fibre curvature, 1/m (zero for a flat blank).
         edge0: (2, 3, T) reference edge vectors ``x1 - x0``, ``x2 - x0`` of every triangle, m.
         deriv0: (5, 3, N) reference node derivatives ``X_X .. X_YY`` (the stencil on the mesh).
-            With these, the kernel can take displacements (``displacement=True``): the edges and derivatives
-            are then ``reference + linear(u)``, free of the rounding of absolute positions (in
-            float32 a 0.1 m coordinate is rounded to 7e-9 m, a strain noise of 1e-6 on 8 mm
-            edges every step, which heats the stiff fibre modes of a long explicit run).
+            With these, the kernel can take displacements (``displacement=True``): the edges and
+            derivatives are then ``reference + linear(u)``, free of the rounding of absolute
+            positions (in float32 a 0.1 m coordinate is rounded to 7e-9 m, a strain noise of
+            1e-6 on 8 mm edges every step, which heats the stiff fibre modes of a long explicit
+            run).
     """
 
     tri_area: Any
@@ -413,8 +414,9 @@ def forces_and_energy_sym(us, shell: Shell):
     uses the symmetry of the Hessian.
 
     Same values as ``forces_and_energy_soa(us, shell, displacement=True)``. Cotangents ``(r, c)``
-    of the forces (3, N) and of the energy parts give ``u_bar = -H r + grad(sum_k c_k E_k)`` with ``-H r`` taken as the *forward* derivative of the
-    forces along ``r`` (``-H`` is symmetric), and ``shell_bar = d/dshell(-grad E . r + sum_k c_k E_k)``.
+    of the forces (3, N) and of the energy parts give ``u_bar = -H r + grad(sum_k c_k E_k)`` with
+    ``-H r`` taken as the *forward* derivative of the forces along ``r`` (``-H`` is symmetric),
+    and ``shell_bar = d/dshell(-grad E . r + sum_k c_k E_k)``.
     Plain reverse mode would transpose every gather of the kernel into a scatter (slow on CPU);
     this way the backward pass has the forward pass's structure. Reverse mode only (no ``jvp``):
     the integrator uses it, :func:`forces_and_energy` stays plain.

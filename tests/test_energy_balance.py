@@ -18,15 +18,22 @@ from jaxform import cases, forming
 N_STEPS = 3000
 
 
-def _run(dtype, n=N_STEPS, *overrides):
+def _case(*overrides):
     case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.0125)
-    case = cases.apply_overrides(case, ["process.stroke_mm=10", "process.frames=3", *overrides])
-    model, state, _ = forming.build(case, dtype=dtype)
-    run = jax.jit(forming.run_steps, static_argnames=("n",))
-    s = run(model, state, state.energies, state.x, n=n)
+    return cases.apply_overrides(case, ["process.stroke_mm=10", "process.frames=3", *overrides])
+
+
+def _energies(case, dtype, n=N_STEPS, dt=None):
+    """``(energies at the start, after n steps)`` of the coarse rig."""
+    model, state, _ = forming.build(case, dtype=dtype, dt=dt)
+    s = jax.jit(forming.run_steps, static_argnames=("n",))(model, state, state.energies, state.x, n=n)
     assert int(s.bad_step) < 0
-    e = s.energies
-    return float(e.balance(state.energies)), float(e.kinetic + e.internal)
+    return state.energies, s.energies
+
+
+def _run(dtype, n=N_STEPS, *overrides):
+    e0, e = _energies(_case(*overrides), dtype, n)
+    return float(e.balance(e0)), float(e.kinetic + e.internal)
 
 
 def test_balance_closes_in_float64():
@@ -49,15 +56,10 @@ def test_fibre_mass_keeps_the_energies_and_closes_the_balance_in_float64():
     res, stored = _run("float64", N_STEPS // 4, *fm)
     assert stored > 1e-6
     assert abs(res) < 5e-3 * stored
-    case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.0125)
-    case = cases.apply_overrides(case, ["process.stroke_mm=10", "process.frames=3", *fm])
+    case = _case(*fm)
     dt = forming.build(case, dtype="float64")[2].dt / 4
-    out = {}
-    for name, c in (("lumped", cases.apply_overrides(case, ["numerics.fibre_mass_scaling=1"])), ("fibre", case)):
-        model, state, _ = forming.build(c, dtype="float64", dt=dt)
-        s = jax.jit(forming.run_steps, static_argnames=("n",))(model, state, state.energies, state.x, n=N_STEPS)
-        assert int(s.bad_step) < 0
-        out[name] = s.energies
+    out = {name: _energies(c, "float64", dt=dt)[1]
+           for name, c in (("lumped", _case(fm[1])), ("fibre", case))}
     for part in ("kinetic", "internal", "bending"):
         a, b = float(getattr(out["lumped"], part)), float(getattr(out["fibre"], part))
         assert b == pytest.approx(a, rel=0.03), part

@@ -12,7 +12,7 @@ from jaxform.integrate import init_state, make_model, simulate
 from jaxform.materials import NCF_FCIM359, WOVEN_38616
 from jaxform.mesh import Mesh
 from jaxform.model import Hold
-from jaxform.shell import Shell, forces, forces_and_energy_soa, membrane_frequency, stable_time_step
+from jaxform.shell import Shell, forces, forces_and_energy_soa, stable_time_step
 
 
 def _shell(angles=(0.0, np.pi / 2), fabric=WOVEN_38616, size=0.005):

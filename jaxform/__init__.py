@@ -13,7 +13,7 @@ Modules along the data flow (imports point one way along it)::
     metrics                   wrinkle metric: tool distance, principal curvatures, zones
     calibrate                 fitting laws to measurements through the model
 
-``jaxform.simulate(case)`` runs a forming case (``jaxform.cases.load(name_or_toml)``).
+``jaxform.simulate(case)`` runs a forming case (a ``Case``, a preset name or a ``.toml`` path).
 Sub-modules are imported on first use, so ``import jaxform`` stays light.
 """
 from __future__ import annotations
@@ -45,7 +45,7 @@ def __getattr__(name: str):
     if name in _MODULES:
         return importlib.import_module(f"jaxform.{name}")
     if name == "simulate":
-        return importlib.import_module("jaxform.forming").simulate
+        return importlib.import_module("jaxform.cases").simulate
     raise AttributeError(f"module 'jaxform' has no attribute {name!r}")
 
 

@@ -23,8 +23,9 @@ balancing ``1/2 m v_{n-½} . v_{n+½}`` by ``m |v_{n+½} - v_{n-½}|^2 / 8``, wh
 and makes a chattering node show up in the balance); gravity work ``m g . (x_n - x_0)``; load,
 damping and boundary (reaction) work by the trapezoidal rule over ``x_{n-1} -> x_n``. The run is
 declared failed at the first step where a value is non-finite or the energy balance residual
-exceeds ``blowup_tol`` times the largest energy scale seen (the signature of an unstable time
-step).
+exceeds ``blowup_tol`` times the largest energy scale seen, or ``energy_floor`` (J) if that is
+larger (the signature of an unstable time step). The floor keeps rounding noise from counting as a
+blow-up while every energy is still tiny (the start of a forming run in float32).
 """
 from __future__ import annotations
 
@@ -200,15 +201,16 @@ def _step(model: Model, state: State, x_ref):
     return x_new.T, v_new.T, e, tuple(new_loads), tuple(extras), (f_loads, f_damp, reaction), (p_new, u_new)
 
 
-def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5) -> State:
+def step(model: Model, state: State, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5,
+         energy_floor: float = 0.0) -> State:
     """Advance one time step (pure). A failed run stays frozen at its last good state."""
     x_ref = model.drive.position(0.0) if x_ref is None else x_ref
     e0 = state.energies if e0 is None else e0
-    new, _ = _advance(model, state, x_ref, e0, blowup_tol)
+    new, _ = _advance(model, state, x_ref, e0, blowup_tol, energy_floor)
     return _freeze_if_failed(state, new)
 
 
-def _advance(model, state, x_ref, e0, blowup_tol):
+def _advance(model, state, x_ref, e0, blowup_tol, energy_floor=0.0):
     """One step and its health check, without freezing: ``(new_state, extras)``.
 
     ``bad_step``/``bad_code`` record the first failing step; the arrays go on (the caller
@@ -220,7 +222,7 @@ def _advance(model, state, x_ref, e0, blowup_tol):
     finite = jnp.isfinite(e.internal) & jnp.isfinite(e.kinetic) & jnp.isfinite(jnp.sum(v_new))
     scale = jnp.maximum(state.scale_max, e.scale())
     tiny = 1e-30 if x_new.dtype == jnp.float64 else 1e-20
-    blown = jnp.abs(e.balance(e0)) > blowup_tol * scale + tiny
+    blown = jnp.abs(e.balance(e0)) > blowup_tol * jnp.maximum(scale, energy_floor) + tiny
     code = jnp.where(~finite, 1, jnp.where(blown, 2, 0)).astype(jnp.int32)
     fail_now = (state.bad_step < 0) & (code > 0)
     new = State(x=x_new, v=v_new, t=state.t + model.dt, step=state.step + 1, energies=e, loads=loads,
@@ -239,7 +241,7 @@ def _freeze_if_failed(start: State, end: State) -> State:
 
 
 def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None, x_ref=None,
-              blowup_tol: float = 0.5):
+              blowup_tol: float = 0.5, energy_floor: float = 0.0):
     """``n`` steps (``lax.scan``; pure, jit-able, differentiable): ``(state, extras of the last step)``.
 
     A stretch in which a step fails returns its starting state (the last good one) with the
@@ -249,14 +251,14 @@ def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None,
     e0 = state.energies if e0 is None else e0
 
     def one(s, _):
-        return _advance(model, s, x_ref, e0, blowup_tol)
+        return _advance(model, s, x_ref, e0, blowup_tol, energy_floor)
 
     end, extras = jax.lax.scan(one, state, None, length=n)
     return _freeze_if_failed(state, end), jax.tree_util.tree_map(lambda a: a[-1], extras)
 
 
 def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint: bool = True,
-            blowup_tol: float = 0.5):
+            blowup_tol: float = 0.5, energy_floor: float = 0.0):
     """Run ``n_frames * every`` steps; return ``(final_state, frames)`` (pure, jit-able, differentiable).
 
     Each chunk of ``every`` steps is a ``lax.scan`` wrapped in ``jax.checkpoint`` (when
@@ -267,7 +269,7 @@ def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint
     x_ref = state.x
 
     def chunk(s):
-        return run_steps(model, s, every, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol)
+        return run_steps(model, s, every, e0=e0, x_ref=x_ref, blowup_tol=blowup_tol, energy_floor=energy_floor)
 
     if checkpoint:
         chunk = jax.checkpoint(chunk)

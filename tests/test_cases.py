@@ -4,7 +4,7 @@ import math
 
 import pytest
 
-from jaxform import cases, materials, tools
+from jaxform import cases, forming, materials, tools
 
 SPEC_NAMES = [f"case-a-{f}-{b}" for f in ("woven", "ncf") for b in ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")]
 SPEC_NAMES += ["case-b-woven-nlbm", "case-b-ncf-nlbm"]
@@ -15,7 +15,7 @@ def test_presets_are_the_spec_names_and_load():
     for name in SPEC_NAMES:
         case = cases.load(name)
         assert case.name == name
-        fab = cases.build_fabric(case)
+        fab = forming.build_fabric(case)
         assert isinstance(fab, materials.Fabric)
         assert fab.membrane_only == name.endswith("membrane")
         assert cases.loads(cases.to_toml(case)) == case  # TOML round trip
@@ -31,21 +31,21 @@ def test_case_a_and_b_match_the_paper():
     b = cases.load("case-b-ncf-nlbm")
     assert b.n_plies == 2 and b.orientations == (0.0, 0.0)
     assert b.holder.mode == "force" and b.holder.force == 1000.0 and b.element_size == pytest.approx(1e-3)
-    assert cases.build_fabric(cases.load("case-a-woven-lbm-41")).bending[0].b == pytest.approx(2.2e-4)
-    assert cases.build_fabric(cases.load("case-a-ncf-lbm-inf")).name.endswith("lbm-inf")
+    assert forming.build_fabric(cases.load("case-a-woven-lbm-41")).bending[0].b == pytest.approx(2.2e-4)
+    assert forming.build_fabric(cases.load("case-a-ncf-lbm-inf")).name.endswith("lbm-inf")
 
 
 def test_build_tools_places_the_rig():
     case = cases.load("case-b-woven-nlbm")
-    rig = cases.build_tools(case)
+    rig = forming.build_tools(case)
     h = case.ply_thickness
     assert isinstance(rig.punch, tools.Punch)
     assert float(rig.punch.apex_z) == pytest.approx(2 * h)
     assert float(rig.holder.bottom_z) == pytest.approx(2 * h)
     assert cases.ply_heights(case) == pytest.approx([1.5 * h, 0.5 * h])
     assert float(rig.punch.motion.displacement(1e3)) == pytest.approx(-0.05)
-    assert cases.stroke_time(case) == pytest.approx(0.05 / 0.5 + 0.5 * 0.1 * 0.1)
-    a = cases.build_tools(cases.load("case-a-woven-nlbm"))
+    assert forming.stroke_time(case) == pytest.approx(0.05 / 0.5 + 0.5 * 0.1 * 0.1)
+    a = forming.build_tools(cases.load("case-a-woven-nlbm"))
     assert float(a.holder.bottom_z) == pytest.approx(7e-3)
 
 
@@ -105,7 +105,7 @@ def test_overrides():
     with pytest.raises(ValueError, match="'holder.gap_mm'"):
         cases.apply_overrides(case, ["holder.gap_mm=0.1"])
     # Custom Voce law reaches the fabric.
-    fab = cases.build_fabric(cases.apply_overrides(case, ["fabric.voce={b_inf_Nm = 2e-5, m0_N = 7e-3, kappa0_per_m = 20.0}"]))
+    fab = forming.build_fabric(cases.apply_overrides(case, ["fabric.voce={b_inf_Nm = 2e-5, m0_N = 7e-3, kappa0_per_m = 20.0}"]))
     assert float(fab.bending[0].b_inf) == pytest.approx(2e-5)
 
 

@@ -49,6 +49,25 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert len(_pvd_files(tmp_out)) == 2
 
 
+def test_a_run_normalises_its_case_and_builds_its_rig_once(tmp_out, monkeypatch):
+    from jaxform import cases
+    from jaxform.forming import rig
+
+    calls = {"tools": 0, "mesh": 0, "load": 0}
+
+    def counting(name, fn):
+        def wrapped(*a, **k):
+            calls[name] += 1
+            return fn(*a, **k)
+        return wrapped
+
+    monkeypatch.setattr(rig, "build_tools", counting("tools", rig.build_tools))
+    monkeypatch.setattr(rig, "build_mesh", counting("mesh", rig.build_mesh))
+    monkeypatch.setattr(cases, "load", counting("load", cases.load))
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--set", "process.frames=2"]) == 0
+    assert calls == {"tools": 1, "mesh": 1, "load": 1}
+
+
 def test_run_refuses_a_users_directory(tmp_out, capsys):
     tmp_out.mkdir()
     (tmp_out / "keep.txt").write_text("mine")

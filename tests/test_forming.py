@@ -37,7 +37,7 @@ def test_build_wires_case_b():
     assert np.all(info.ply_id[tri] == 2)
     assert np.all(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])[:, 2] > 0)
     # whole steps per frame, the stroke exactly covered
-    assert info.n_steps * info.dt == pytest.approx(cases.stroke_time(case), rel=1e-12)
+    assert info.n_steps * info.dt == pytest.approx(forming.stroke_time(case), rel=1e-12)
     assert info.every % info.samples_per_frame == 0
     assert n == 2 * 11 * 11 or n == 2 * 13 * 13
     # NCF fibres at +-45 degrees (orientation 0)

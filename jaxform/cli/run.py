@@ -13,6 +13,8 @@ import pathlib
 import sys
 import time
 
+from jaxform.cli.progress import Progress
+
 FIELD_UNITS = {
     "displacement": "m", "shear_angle_deg": "degree", "fibre_strain": "-", "bending_moment": "N (N·m/m)",
     "M_f_rms": "N", "contact_pressure": "Pa", "deviation": "m", "ply_id": "-",
@@ -35,48 +37,6 @@ def add_parser(subparsers) -> None:
     p.set_defaults(handler=run)
 
 
-class Progress:
-    """A one-line progress bar on stderr: percent, punch displacement, elapsed time and ETA."""
-
-    def __init__(self, stream=None, width: int = 28, quiet: bool = False):
-        self.stream = stream or sys.stderr
-        self.width = width
-        self.quiet = quiet
-        self.first = None  # (steps, elapsed) at the first report (after compilation)
-        self.last_len = 0
-
-    def __call__(self, step, n_steps, t, disp, elapsed):
-        if self.quiet:
-            return
-        if self.first is None:
-            self.first = (step, elapsed)
-            eta = None
-        else:
-            s0, e0 = self.first
-            rate = (elapsed - e0) / max(step - s0, 1)
-            eta = rate * (n_steps - step)
-        frac = step / max(n_steps, 1)
-        bar = "#" * int(frac * self.width)
-        eta_s = "--" if eta is None else _hms(eta)
-        line = (f"\r[{bar:<{self.width}}] {100 * frac:5.1f}%  punch {disp * 1e3:6.2f} mm  "
-                f"elapsed {_hms(elapsed)}  ETA {eta_s}")
-        self.stream.write(line + " " * max(0, self.last_len - len(line)))
-        self.stream.flush()
-        self.last_len = len(line)
-
-    def done(self):
-        if not self.quiet and self.last_len:
-            self.stream.write("\n")
-            self.stream.flush()
-
-
-def _hms(s: float) -> str:
-    s = max(0, int(round(s)))
-    h, r = divmod(s, 3600)
-    m, s = divmod(r, 60)
-    return f"{h:d}:{m:02d}:{s:02d}" if h else f"{m:d}:{s:02d}"
-
-
 def point_data(fields: dict, ply_id) -> dict:
     """The VTU point fields of a frame (names with their unit in :data:`FIELD_UNITS`)."""
     import numpy as np
@@ -95,60 +55,46 @@ def point_data(fields: dict, ply_id) -> dict:
 
 
 def execute(case, out, *, force=False, quiet=False, stream=None, element_size=None, overrides=(), owner="run",
-            **sim_kwargs):
+            **build_kwargs):
     """Run ``case`` writing everything into ``out``; returns ``(result, written_paths)``.
 
-    Shared by ``jaxform run`` and ``jaxform demo``. Never raises for a failed or interrupted run:
-    the result says ``complete=False`` and why.
+    Shared by ``jaxform run`` and ``jaxform demo``. The case is normalised once and the rig built
+    once; the frames, the summary and the plots read what the rig built. Never raises for a failed
+    or interrupted run: the result says ``complete=False`` and why.
     """
     from jaxform import cases, forming
     from jaxform.io.frames import FrameWriter, write_json
     from jaxform.io.output import prepare_output_dir
 
-    if not isinstance(case, cases.Case):
-        case = cases.load(case)
-    if element_size is not None:
-        case = cases.with_element_size(case, element_size)
-    if overrides:
-        case = cases.apply_overrides(case, list(overrides))
+    case = cases.resolve(case, element_size=element_size, overrides=overrides)
     out = prepare_output_dir(out, force=force, owner=owner)
     summary_path = out / "summary.json"
-    write_json(summary_path, {"complete": False, "reason": "running (or killed before it could say why)",
-                              "case": case.name, "inputs": cases.to_dict(case), "max_ke_ie": None,
-                              "max_shear_angle_deg": None, "wall_time_s": None})
-    state = {"writer": None}
+    t0 = time.perf_counter()
+
+    def early_summary(reason):
+        return {"complete": False, "reason": reason, "case": case.name, "inputs": cases.to_dict(case),
+                "max_ke_ie": None, "max_shear_angle_deg": None, "wall_time_s": time.perf_counter() - t0}
+
+    write_json(summary_path, early_summary("running (or killed before it could say why)"))
+    progress = Progress(stream=stream, quiet=quiet)
+    try:
+        rig = forming.build(case, **build_kwargs)
+    except BaseException as err:  # set-up errors (before the first frame): say so in the summary
+        write_json(summary_path, early_summary(f"error before the run started: {err}"))
+        raise
+    writer = FrameWriter(out, rig.info.faces, stem="frames")
 
     def on_frame(k, t, x, fields):
-        if state["writer"] is None:
-            state["writer"] = FrameWriter(out, state["faces"], stem="frames")
-        state["writer"].write(t, x, point_data(fields, state["ply_id"]))
+        writer.write(t, x, point_data(fields, rig.info.ply_id))
 
-    progress = Progress(stream=stream, quiet=quiet)
-    # the faces are known only after building: peek through a tiny wrapper
-    from jaxform.forming import build_mesh, grid_quads
-
-    mesh = build_mesh(case)
-    import numpy as np
-
-    state["faces"] = grid_quads(*mesh.shape, plies=case.n_plies)
-    ply = np.zeros(mesh.n_nodes, np.int32)
-    for i, (a, b) in enumerate(mesh.ply_nodes):
-        ply[a:b] = i + 1
-    state["ply_id"] = ply
-    t0 = time.perf_counter()
+    progress.start(rig.info.n_steps, case.name)
     try:
-        result = forming.simulate(case, on_frame=on_frame, on_progress=progress, catch=True, **sim_kwargs)
-    except BaseException as err:  # set-up errors (before the first frame): say so in the summary
+        result = forming.run(rig, on_frame=on_frame, on_progress=progress, catch=True)
+    finally:
         progress.done()
-        write_json(summary_path, {"complete": False, "reason": f"error before the run started: {err}",
-                                  "case": case.name, "inputs": cases.to_dict(case), "max_ke_ie": None,
-                                  "max_shear_angle_deg": None, "wall_time_s": time.perf_counter() - t0})
-        raise
-    progress.done()
-    result.summary["wall_time_s"] = time.perf_counter() - t0
-    written = []
-    if state["writer"] is not None:
-        written.append(state["writer"].pvd_path)
+    result.wall_time_s = time.perf_counter() - t0
+    result.summary["wall_time_s"] = result.wall_time_s
+    written = [writer.pvd_path] if len(result.t) else []
     if len(result.t) >= 1:
         written += _plots(result, out)
     write_json(summary_path, result.summary)

@@ -1,0 +1,228 @@
+"""Running a built rig: pure chunks of steps and a differentiable rollout, and the host driver
+that writes frames as they come (callbacks for progress and output).
+
+``simulate(case)`` = ``run(build(case))``: the rig is built once. The run's health is checked by the integrator itself, every step (non-finite values, or an
+energy-balance residual above half the largest energy seen, with a floor of :data:`ENERGY_FLOOR`
+so that float32 rounding at the start of a run never counts); the driver only reads the record.
+"""
+from __future__ import annotations
+
+import dataclasses
+import time
+from typing import Any, Callable
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxform import integrate
+from jaxform.forming.case import Case
+from jaxform.forming.fields import ENERGY_KEYS, SCALARS, fields_jit
+from jaxform.forming.presets import apply_overrides, with_element_size
+from jaxform.forming.rig import Rig, RunInfo, build
+from jaxform.forming.summary import summarize
+
+BLOWUP_TOL = 0.5
+"""An energy-balance residual above this fraction of the largest energy seen is a blow-up."""
+ENERGY_FLOOR = {"float32": 1e-3, "float64": 1e-8}
+"""J: an energy-balance residual below this never counts as a blow-up (float32 rounding noise of
+the accounts; the shell itself works on displacements, see :class:`jaxform.shell.ShellRef`)."""
+
+
+def _floor(state) -> float:
+    return ENERGY_FLOOR["float64" if state.x.dtype == jnp.float64 else "float32"]
+
+
+def run_steps(model, state, e0, x_ref, n: int, energy_floor: float | None = None):
+    """``n`` integrator steps (pure; :func:`jaxform.integrate.run_steps` with the forming health
+    check, the floor by default :data:`ENERGY_FLOOR` of the state's dtype: a failed stretch returns
+    its starting state with the failing step recorded)."""
+    floor = _floor(state) if energy_floor is None else energy_floor
+    return integrate.run_steps(model, state, n, e0=e0, x_ref=x_ref, blowup_tol=BLOWUP_TOL, energy_floor=floor)[0]
+
+
+_run_steps_jit = jax.jit(run_steps, static_argnames=("n", "energy_floor"))
+
+
+def rollout(model, state, info: RunInfo, *, n_frames: int | None = None, checkpoint: bool = True):
+    """Pure, differentiable run of ``n_frames - 1`` frame intervals (default: the whole stroke).
+
+    Returns ``(final_state, frames)`` (:class:`jaxform.integrate.Frames`, the initial frame not
+    included). Use inside ``jax.grad``/``jax.jit`` (``info`` is static: close over it). A failed
+    run is frozen at its last good frame: check ``final_state.bad_step < 0``.
+    """
+    nf = info.n_frames if n_frames is None else int(n_frames)
+    return integrate.rollout(model, state, nf - 1, info.every, checkpoint=checkpoint, blowup_tol=BLOWUP_TOL,
+                             energy_floor=_floor(state))
+
+
+@dataclasses.dataclass
+class FormingResult:
+    """Outcome of :func:`run` (numpy arrays; frames written so far if incomplete).
+
+    Attributes:
+        t: (F,) frame times, s; x: (F, N, 3) positions, m; fields: dict of (F, N, ...) nodal
+            fields (see :func:`jaxform.forming.fields.state_fields`); history: dict of (S,) sampled
+            time series (``t``, ``punch_displacement``, ``punch_force``, ``holder_force``, energies...);
+        faces, ply_id: mesh connectivity (F, 4) and (N,) ply numbers; info: :class:`RunInfo`;
+        complete: bool; reason: why it stopped early (None when complete); wall_time_s; summary:
+        dict (see :func:`jaxform.forming.summary.summarize`); final_state: last
+        :class:`~jaxform.model.State`; model: the :class:`~jaxform.model.Model` that ran.
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    fields: dict
+    history: dict
+    faces: np.ndarray
+    ply_id: np.ndarray
+    info: RunInfo
+    complete: bool
+    reason: str | None
+    wall_time_s: float
+    summary: dict
+    final_state: Any = None
+    model: Any = None
+
+    @property
+    def shear_angle_deg(self) -> np.ndarray:
+        """(F, N) shear angle per node, degrees."""
+        return np.degrees(self.fields["shear_angle"])
+
+    def __repr__(self) -> str:
+        state = "complete" if self.complete else f"incomplete: {self.reason}"
+        return (f"FormingResult(case={self.info.case.name!r}, {state}, frames={len(self.t)}, "
+                f"nodes={len(self.info.x0)}, wall_time_s={self.wall_time_s:.1f})")
+
+
+def _single_frame(s):
+    return integrate.Frames(x=s.x[None], v=s.v[None], t=s.t[None], step=s.step[None],
+                            energies=jax.tree_util.tree_map(lambda a: a[None], s.energies), extras=(),
+                            ok=jnp.zeros((1,), bool))
+
+
+class _Recorder:
+    """Host-side frames and sampled histories of a run."""
+
+    def __init__(self, on_frame):
+        self.on_frame = on_frame
+        self.t, self.x, self.fields = [], [], {}
+        self.hist: dict[str, list] = {k: [] for k in ("t", "step") + SCALARS + ENERGY_KEYS}
+
+    def sample(self, s, fl):
+        self.hist["t"].append(float(s.t))
+        self.hist["step"].append(int(s.step))
+        for k in SCALARS:
+            self.hist[k].append(float(fl[k]))
+        for k in ENERGY_KEYS:
+            self.hist[k].append(float(getattr(s.energies, k)))
+
+    def frame(self, s, fl):
+        k = len(self.t)
+        host = {kk: np.asarray(v) for kk, v in fl.items() if kk not in SCALARS}
+        self.t.append(float(s.t))
+        self.x.append(np.asarray(s.x))
+        for kk, v in host.items():
+            self.fields.setdefault(kk, []).append(v)
+        if self.on_frame is not None:
+            self.on_frame(k, float(s.t), self.x[-1], host)
+
+
+def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False,
+        build_only: bool = False) -> FormingResult:
+    """Run a built rig on the host, chunk by chunk (``info.sub_steps`` steps per jitted call).
+
+    Args:
+        rig: :func:`jaxform.forming.build`'s ``(model, state, info)``.
+        on_frame: ``on_frame(k, t, x (N,3), fields dict)`` called after each frame (frame 0: start).
+        on_progress: ``on_progress(step, n_steps, t, punch_displacement_m, elapsed_s)`` per chunk.
+        catch: return an incomplete result (``complete=False`` and ``reason``) instead of raising
+            on failure or ``KeyboardInterrupt``.
+        build_only: write the initial frame only.
+
+    Returns:
+        :class:`FormingResult` (its ``summary`` filled by :func:`jaxform.forming.summary.summarize`).
+    """
+    t_wall = time.perf_counter()
+    model, state, info = rig
+    ply_arr = jnp.asarray(info.ply_id)
+    n_plies = info.case.n_plies
+    e0, x_ref = state.energies, state.x
+    floor = _floor(state)
+    rec = _Recorder(on_frame)
+    complete, reason = False, None
+    try:
+        fl = fields_jit(model, state, ply_arr, n_plies=n_plies)
+        rec.sample(state, fl)
+        rec.frame(state, fl)
+        if not build_only:
+            for _ in range(info.n_frames - 1):
+                for _ in range(info.samples_per_frame):
+                    new = _run_steps_jit(model, state, e0, x_ref, n=info.sub_steps, energy_floor=floor)
+                    if int(new.bad_step) >= 0:
+                        integrate.check(new, _single_frame(new), model)
+                    state = new
+                    fl = fields_jit(model, state, ply_arr, n_plies=n_plies)
+                    rec.sample(state, fl)
+                    if on_progress is not None:
+                        on_progress(int(state.step), info.n_steps, float(state.t), float(fl["punch_displacement"]),
+                                    time.perf_counter() - t_wall)
+                rec.frame(state, fl)
+            complete = True
+    except KeyboardInterrupt:
+        if not catch:
+            raise
+        reason = "interrupted by the user (KeyboardInterrupt)"
+    except integrate.SimulationError as err:
+        if not catch:
+            raise
+        reason = f"simulation failed: {err}"
+    except Exception as err:  # noqa: BLE001 - reported in the summary, re-raised unless catch
+        if not catch:
+            raise
+        reason = f"error: {type(err).__name__}: {err}"
+    if build_only:
+        complete, reason = False, "build only"
+    result = FormingResult(
+        t=np.asarray(rec.t), x=np.asarray(rec.x), fields={k: np.asarray(v) for k, v in rec.fields.items()},
+        history={k: np.asarray(v) for k, v in rec.hist.items()}, faces=info.faces, ply_id=info.ply_id, info=info,
+        complete=complete, reason=reason, wall_time_s=time.perf_counter() - t_wall, summary={}, final_state=state,
+        model=model)
+    result.summary = summarize(result)
+    return result
+
+
+def simulate(case: Case, *, dtype=None, element_size: float | None = None, overrides=(),
+             on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False, fabric=None,
+             samples_per_frame: int = 10, damping: float = 0.0, dt: float | None = None,
+             build_only: bool = False) -> FormingResult:
+    """Run a forming case: apply the overrides once, build the rig once, run it (:func:`run`).
+
+    Args:
+        case: a :class:`~jaxform.forming.case.Case` (``jaxform.cases.load(name_or_toml)``;
+            ``jaxform.simulate`` also takes the name or path itself).
+        dtype: overrides the case's ``numerics.dtype``.
+        element_size: overrides ``blank.element_size_mm`` (m).
+        overrides: ``["section.key=value", ...]`` (:func:`jaxform.forming.presets.apply_overrides`).
+        on_frame, on_progress, catch, build_only: see :func:`run`.
+        fabric, samples_per_frame, damping, dt: see :func:`jaxform.forming.build`.
+
+    Returns:
+        :class:`FormingResult`; its ``wall_time_s`` includes building the rig.
+    """
+    if not isinstance(case, Case):
+        raise TypeError(f"forming.simulate: case is a {type(case).__name__}; give a Case "
+                        "(jaxform.cases.load(name_or_toml)) or call jaxform.simulate, which takes names and paths")
+    t_wall = time.perf_counter()
+    if element_size is not None:
+        case = with_element_size(case, element_size)
+    if overrides:
+        case = apply_overrides(case, list(overrides))
+    rig = build(case, dtype=dtype, fabric=fabric, samples_per_frame=samples_per_frame, damping=damping, dt=dt)
+    result = run(rig, on_frame=on_frame, on_progress=on_progress, catch=catch, build_only=build_only)
+    result.wall_time_s = time.perf_counter() - t_wall
+    result.summary["wall_time_s"] = result.wall_time_s
+    return result
+
+
+__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "run", "simulate"]

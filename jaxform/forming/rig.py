@@ -1,0 +1,365 @@
+"""The rig of a forming run, built once: Case -> (Model, State, RunInfo).
+
+Rig (see :mod:`jaxform.tools`): z up, die top face at z = 0, the stack lies on the die (ply 1 on
+top, at :func:`jaxform.forming.case.ply_heights`), the holder above it (fixed gap, or
+force-controlled in Case B), the punch apex on the stack moving down by the stroke.
+
+Loads, in ``model.loads`` order: punch, die, holder (:class:`jaxform.contact.ToolLoad`), then one
+:class:`jaxform.contact.PlyLoad` per neighbouring ply pair (the upper ply's nodes against the lower
+ply's upward-facing triangles, gap ``h``, fabric–fabric friction). Ply 1 touches punch and holder,
+ply n the die, middle plies only their neighbours. Every tool contact acts at the ply's face
+(offset ``h / 2``) with each node's tributary area.
+
+Numerics (documented choices):
+* time step: ``dt_safety`` (0.75) times the shell's stable estimate, rounded down so that a whole
+  number of steps fills each frame interval; the automatic penalty stiffness caps it on coarse
+  meshes (:func:`build`);
+* gravity :data:`jaxform.units.GRAVITY` along -z, divided by the mass scaling so the physical
+  weight is kept;
+* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed, raised
+  under high pressure so that explicit stick stays stable (:mod:`jaxform.contact`);
+* optional fibre-selective mass scaling ``numerics.fibre_mass_scaling`` (:mod:`jaxform.fibre_mass`):
+  the step's membrane limit grows by that factor (the contact cap then usually needs a larger
+  ``contact.safety``);
+* Case B holder: mass ``holder.mass_kg``, critically damped on its contact stiffness.
+"""
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxform import contact, integrate, units
+from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
+from jaxform.mesh import Mesh
+from jaxform.shell import Shell, stable_time_step
+
+PUNCH, DIE, HOLDER = 0, 1, 2
+"""Indices of the three tools in ``model.loads``."""
+
+
+@dataclasses.dataclass(frozen=True)
+class RunInfo:
+    """Host-side facts about a built run (numpy arrays, plain numbers).
+
+    Attributes:
+        case: the :class:`~jaxform.forming.case.Case`.
+        dt: time step, s; every: steps per frame interval; samples_per_frame: host chunks per frame.
+        n_frames: frames including the initial one; n_steps: total steps; stroke_time: s.
+        faces: (F, 4) quads of all plies (node indices, for output); ply_id: (N,) 1-based ply of each node.
+        x0: (N, 3) initial positions, m.
+        edge_mid: (4,) node indices of ply 1's edge mid-sides (+x, -x, +y, -y); corners: (4,).
+        n_ply_loads: number of ply–ply loads (after the three tools).
+        stable_dt: stable estimate of the shell alone, s.
+    """
+
+    case: Any
+    dt: float
+    every: int
+    samples_per_frame: int
+    n_frames: int
+    n_steps: int
+    stroke_time: float
+    faces: np.ndarray
+    ply_id: np.ndarray
+    x0: np.ndarray
+    edge_mid: np.ndarray
+    corners: np.ndarray
+    n_ply_loads: int
+    stable_dt: float
+
+    @property
+    def sub_steps(self) -> int:
+        return self.every // self.samples_per_frame
+
+    def __repr__(self) -> str:
+        return (f"RunInfo(case={self.case.name!r}, nodes={len(self.x0)}, dt={self.dt:.3e} s, "
+                f"n_steps={self.n_steps}, n_frames={self.n_frames})")
+
+
+class Rig(NamedTuple):
+    """A built run: fixed :class:`~jaxform.model.Model`, initial :class:`~jaxform.model.State`,
+    host facts :class:`RunInfo` (unpacks as ``model, state, info``)."""
+
+    model: Any
+    state: Any
+    info: RunInfo
+
+
+# ---------------------------------------------------------------------------------------------
+# Pieces of the rig
+# ---------------------------------------------------------------------------------------------
+
+
+def grid_quads(nx: int, ny: int, plies: int = 1) -> np.ndarray:
+    """(Q, 4) counter-clockwise quads (p, q, s, r) of an ``nx`` x ``ny`` node grid, per ply stacked."""
+    idx = np.arange(nx * ny).reshape(ny, nx)
+    p, q = idx[:-1, :-1].ravel(), idx[:-1, 1:].ravel()
+    r, s = idx[1:, :-1].ravel(), idx[1:, 1:].ravel()
+    one = np.stack([p, q, s, r], 1)
+    return np.concatenate([one + k * nx * ny for k in range(plies)]).astype(np.int64)
+
+
+def build_mesh(case: Case) -> Mesh:
+    """The blank: one ``blank_size`` square of about ``element_size`` quads per ply, ply 1 on top (m).
+
+    Each quad is split into two triangles along alternating diagonals ("union jack"), with an even
+    number of quads along each side (the element size is rounded to make it so): the triangulation
+    is then mirror-symmetric about both blank axes, like the fabric and the rig. (A single diagonal
+    direction makes the +45° and -45° directions respond differently and the shear map loses its
+    mirror symmetry.) ``mesh.faces`` gives triangles; :func:`grid_quads` the quads for output.
+    """
+    n = case.n_plies
+    nq = 2 * max(1, int(round(case.blank_size / (2.0 * case.element_size))))
+    xs = np.linspace(-0.5 * case.blank_size, 0.5 * case.blank_size, nq + 1)
+    mesh = Mesh.grid(xs, xs, plies=n, ply_spacing=0.0)
+    nodes = np.array(mesh.nodes, dtype=np.float64)
+    for (a, b), z in zip(mesh.ply_nodes, ply_heights(case)):
+        nodes[a:b, 2] = z
+    quads = grid_quads(nq + 1, nq + 1)
+    i, j = np.meshgrid(np.arange(nq), np.arange(nq), indexing="xy")
+    even = ((i + j) % 2 == 0).ravel()
+    p, q, s, r = quads[:, 0], quads[:, 1], quads[:, 2], quads[:, 3]
+    t1 = np.where(even[:, None], np.stack([p, q, s], 1), np.stack([p, q, r], 1))
+    t2 = np.where(even[:, None], np.stack([p, s, r], 1), np.stack([q, s, r], 1))
+    tris1 = np.stack([t1, t2], 1).reshape(-1, 3)
+    npp = (nq + 1) ** 2
+    tris = np.concatenate([tris1 + k * npp for k in range(n)]).astype(np.int32)
+    e1 = nodes[tris[:, 1]] - nodes[tris[:, 0]]
+    e2 = nodes[tris[:, 2]] - nodes[tris[:, 0]]
+    area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
+    node_area = np.zeros(len(nodes))
+    np.add.at(node_area, tris.ravel(), np.repeat(area / 3.0, 3))
+    return mesh.replace(nodes=nodes, tris=tris, node_area=node_area, quads=False)
+
+
+def build_fabric(case: Case):
+    """The :class:`jaxform.materials.Fabric` of the case (preset, overrides, bending model)."""
+    from jaxform import materials
+
+    fab = materials.preset(case.fabric.preset)
+    f = case.fabric
+    changes = {}
+    if f.thickness is not None:
+        changes["thickness"] = f.thickness
+    if f.areal_mass is not None:
+        changes["areal_mass"] = f.areal_mass
+    if f.friction_tool is not None:
+        changes["friction_tool"] = f.friction_tool
+    if f.friction_fabric is not None:
+        changes["friction_fabric"] = f.friction_fabric
+    if f.voce is not None:
+        law = materials.VoceBending(b_inf=f.voce[0], m0=f.voce[1], kappa0=f.voce[2])
+        changes["bending"] = (law, law)
+    if f.shear_poly is not None:
+        changes["shear"] = materials.PolynomialShear(list(f.shear_poly))
+    if changes:
+        fab = fab.replace(**changes)
+    if f.bending == "membrane":
+        return materials.membrane_only(fab)
+    if f.bending in LBM_VARIANTS:
+        return materials.lbm_variant(fab, LBM_VARIANTS[f.bending])
+    return fab
+
+
+def ply_fabrics(case: Case, fabric=None) -> tuple:
+    """One fabric per ply: the case's (or ``fabric``) with fibre angles rotated by the orientations."""
+    fab = build_fabric(case) if fabric is None else fabric
+    return tuple(fab.replace(fibre_angles=tuple(float(t) + float(a) for t in fab.fibre_angles))
+                 for a in case.orientations)
+
+
+def punch_motion(case: Case):
+    """The punch's :class:`jaxform.tools.VerticalMotion`: down by ``stroke`` at ``speed`` with a
+    linear speed ramp over ``ramp_fraction`` of the stroke time."""
+    from jaxform import tools
+
+    p = case.process
+    return tools.VerticalMotion(velocity=-p.speed, ramp_time=p.ramp_fraction * p.stroke / p.speed, stroke=p.stroke)
+
+
+def stroke_time(case: Case) -> float:
+    """Simulated time to complete the stroke, s (speed ramp included); builds no tool."""
+    return punch_motion(case).time_to_stroke()
+
+
+def build_tools(case: Case):
+    """The rig as :class:`jaxform.tools.FormingTools` in the reference pose.
+
+    Die top face at ``z = 0``; the stack (``n`` plies of thickness ``h``) on it, ply mid-surfaces
+    at ``z = (n - i + 1/2) h`` for ply ``i`` (ply 1 on top, touching the punch); holder lower face
+    at ``z = gap`` (gap mode) or on the stack, ``z = n h`` (force mode); punch apex on the stack's
+    upper surface, moving as :func:`punch_motion`. A mesh punch is read and sampled here (once per run).
+    """
+    from jaxform import tools
+
+    t = case.tools
+    stack = case.stack_thickness
+    motion = punch_motion(case)
+    if t.punch_mesh is not None:
+        from jaxform.io.tool_mesh import load_tool_sdf
+
+        punch = load_tool_sdf(t.punch_mesh, cell=t.punch_mesh_cell, units=t.punch_mesh_units, motion=motion)
+    else:
+        punch = tools.Punch(radius=t.punch_radius, apex_z=stack, motion=motion)
+    die = tools.Die(opening_radius=t.die_opening_radius, fillet_radius=t.die_fillet, thickness=t.die_thickness,
+                    top_z=0.0)
+    bottom = case.holder.gap if case.holder.mode == "gap" else stack
+    holder = tools.BlankHolder(opening_radius=t.holder_opening_radius, edge_radius=t.holder_edge_radius,
+                               thickness=t.holder_thickness, bottom_z=bottom)
+    return tools.FormingTools(punch=punch, die=die, holder=holder)
+
+
+def _edge_nodes(mesh: Mesh, n0: int):
+    nx, ny = mesh.shape
+    j_mid, i_mid = ny // 2, nx // 2
+    mid = [j_mid * nx + nx - 1, j_mid * nx, (ny - 1) * nx + i_mid, i_mid]
+    corners = [0, nx - 1, (ny - 1) * nx, ny * nx - 1]
+    return np.asarray(mid) + n0, np.asarray(corners) + n0
+
+
+def _time_step(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float, samples_per_frame: int):
+    """``(dt, every, stroke time)``: the step filling each frame interval with a whole number of
+    host chunks. The automatic penalty stiffness k = safety rho_A / dt^2 must keep the penetration
+    under 1e5 Pa below 10% of the ply (:func:`jaxform.contact.contact_params` checks it): on coarse
+    meshes that caps dt."""
+    dt_max = dt_safety * stable if dt is None else float(dt)
+    c = case.contact
+    if c.penalty_stiffness is None and dt is None:
+        rho_a = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
+        dt_contact = math.sqrt(c.safety * rho_a * 0.1 * float(case.ply_thickness) / 1.0e5)
+        dt_max = min(dt_max, 0.98 * dt_contact)
+    T = stroke_time(case)
+    n_int = int(case.process.frames) - 1
+    every = samples_per_frame * max(1, math.ceil(T / dt_max / (n_int * samples_per_frame)))
+    return T / (n_int * every), every, T
+
+
+def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype):
+    """The contact loads in ``model.loads`` order and their initial holder state."""
+    tools_rig = build_tools(case)
+    h = float(case.ply_thickness)
+    fab0 = fabrics[0]
+    rho = float(np.max(np.asarray(fab0.areal_mass))) * float(case.mass_scaling)
+    c = case.contact
+    speed = float(case.process.speed)
+    n_if = 2 if case.n_plies > 1 else 1  # frictional contacts per node (stack: tool + ply, or two plies)
+    common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
+                  damping_ratio=c.damping_ratio, safety=c.safety, interfaces=n_if)
+    params_tool = contact.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
+    params_ply = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
+
+    area = np.asarray(mesh.node_area, np.float64)
+    ply_id = _ply_ids(mesh)
+    top = (ply_id == 1).astype(np.float64)
+    bottom = (ply_id == case.n_plies).astype(np.float64)
+    as_arr = lambda a: jnp.asarray(a, jdtype)  # noqa: E731
+    face = dict(params=params_tool, offset=as_arr(h / 2), area=as_arr(area))
+    punch = contact.ToolLoad(tool=tools_rig.punch, active=as_arr(top), **face)
+    die = contact.ToolLoad(tool=tools_rig.die, active=as_arr(bottom), **face)
+    holder_state = None
+    if case.holder.mode == "force":
+        r = np.hypot(mesh.nodes[:, 0], mesh.nodes[:, 1])
+        ring = float(np.sum(area * top * (r > float(case.tools.holder_opening_radius))))
+        k_ring = float(params_tool.stiffness) * ring
+        m_h = float(case.holder.mass)
+        holder = contact.ToolLoad(tool=tools_rig.holder, active=as_arr(top), clamp_force=as_arr(case.holder.force),
+                                  mass=as_arr(m_h), damping=as_arr(2.0 * math.sqrt(k_ring * m_h)), dt=as_arr(dt),
+                                  force_controlled=True, **face)
+        holder_state = contact.HolderState(dz=jnp.zeros((), jdtype), vz=jnp.zeros((), jdtype))
+    else:
+        holder = contact.ToolLoad(tool=tools_rig.holder, active=as_arr(top), **face)
+    loads = [punch, die, holder]
+    tris = np.asarray(mesh.tris)
+    for i in range(case.n_plies - 1):
+        (a, b), (t0, t1) = mesh.ply_nodes[i], mesh.ply_tris[i + 1]
+        loads.append(contact.PlyLoad(slave=jnp.asarray(np.arange(a, b), jnp.int32),
+                                     triangles=jnp.asarray(tris[t0:t1], jnp.int32), gap0=as_arr(h),
+                                     area=as_arr(area[a:b]), params=params_ply))
+    return tuple(loads), holder_state
+
+
+def _ply_ids(mesh: Mesh) -> np.ndarray:
+    ply_id = np.zeros(mesh.n_nodes, np.int32)
+    for i, (a, b) in enumerate(mesh.ply_nodes):
+        ply_id[a:b] = i + 1
+    return ply_id
+
+
+# ---------------------------------------------------------------------------------------------
+# The rig
+# ---------------------------------------------------------------------------------------------
+
+
+def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75, samples_per_frame: int = 10,
+          fabric=None, damping: float = 0.0) -> Rig:
+    """Build a forming run once: mesh, fabrics, shell, tools, contact loads, time step, initial state.
+
+    Args:
+        case: a :class:`~jaxform.forming.case.Case` (``jaxform.cases.load(NAME)``, normalised with
+            :func:`jaxform.cases.resolve`).
+        dtype: ``"float32"``/``"float64"`` (default: the case's ``numerics.dtype``).
+        dt: time step, s (default ``dt_safety`` times the stable estimate); rounded down to fill
+            frame intervals with whole steps.
+        samples_per_frame: host chunks per frame interval (progress and force-curve samples).
+        fabric: a :class:`~jaxform.materials.Fabric` replacing the case's (e.g. custom laws).
+        damping: mass-proportional damping, 1/s (default none).
+
+    Returns:
+        :class:`Rig` ``(model, state, info)``.
+    """
+    dtype_name = dtype or case.dtype
+    if dtype_name not in ("float32", "float64"):
+        raise ValueError(f"forming.build: dtype = {dtype_name!r}: must be 'float32' or 'float64'")
+    if dtype_name == "float64" and not jax.config.jax_enable_x64:
+        raise ValueError("forming.build: dtype float64 needs jax.config.update('jax_enable_x64', True) "
+                         "before anything else runs (or use numerics.dtype = 'float32')")
+    jdtype = jnp.float64 if dtype_name == "float64" else jnp.float32
+    if int(case.process.frames) < 2:
+        raise ValueError(f"case key 'process.frames' = {case.process.frames}: need at least 2 (start and end)")
+    samples_per_frame = int(samples_per_frame)
+    if samples_per_frame < 1:
+        raise ValueError("forming.build: samples_per_frame must be >= 1")
+
+    mesh = build_mesh(case)
+    fabrics = ply_fabrics(case, fabric)
+    shell = Shell.build(mesh, fabrics)
+    ms = float(case.mass_scaling)
+    fms = float(case.fibre_mass_scaling)
+    stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
+    dt, every, T = _time_step(case, fabrics, stable, dt, dt_safety, samples_per_frame)
+    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype)
+    model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
+                                 gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
+                                 fibre_mass_factor=fms)
+    x0 = jnp.asarray(mesh.nodes, jdtype)
+    load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
+    # jitted: eager (op-by-op) evaluation of the shell forces costs seconds
+    state = _init_state(model, tuple(load_states))
+    mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
+    n_int = int(case.process.frames) - 1
+    info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
+                   n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
+                   ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,
+                   n_ply_loads=case.n_plies - 1, stable_dt=stable)
+    return Rig(model, state, info)
+
+
+@jax.jit
+def _init_state(model, load_states):
+    return integrate.init_state(model, load_states=load_states)
+
+
+def with_fabric(model, fabric):
+    """The model with ``fabric``'s laws on every ply (fibre angles of each ply kept). Pure: use it
+    inside a differentiated function to take gradients w.r.t. the fabric's parameters."""
+    fabs = tuple(fabric.replace(fibre_angles=f.fibre_angles) for f in model.shell.fabrics)
+    return model.replace(shell=model.shell.replace(fabrics=fabs))
+
+
+__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
+           "ply_fabrics", "punch_motion", "stroke_time", "build_tools", "with_fabric"]

@@ -1,0 +1,147 @@
+"""What a forming run says, on the host (numpy): draw-in, flange profile and wrinkle count,
+mirror symmetry, and the JSON-ready summary (SPEC section 6 keys)."""
+from __future__ import annotations
+
+import math
+
+import jax
+import numpy as np
+
+from jaxform.forming.case import to_dict
+from jaxform.forming.fields import ENERGY_KEYS
+from jaxform.forming.rig import RunInfo
+
+
+def draw_in(x, info: RunInfo) -> dict:
+    """Blank-edge draw-in of ply 1, m: mean over the four edge mid-sides and the four corners.
+
+    Mid-side: the reduction of the distance to the punch axis along the edge normal; corner: the
+    reduction of the radial distance.
+    """
+    x = np.asarray(x)
+    x0 = info.x0
+    mid, cor = info.edge_mid, info.corners
+    axis = np.array([0, 0, 1, 1])
+    d_mid = np.abs(x0[mid, axis]) - np.abs(x[mid, axis])
+    d_cor = np.hypot(x0[cor, 0], x0[cor, 1]) - np.hypot(x[cor, 0], x[cor, 1])
+    return {"edge_mid_m": float(np.mean(d_mid)), "corner_m": float(np.mean(d_cor)),
+            "edge_mid_each_m": d_mid.tolist(), "corner_each_m": d_cor.tolist()}
+
+
+def flange_mask(x_ref, case) -> np.ndarray:
+    """(N,) nodes initially on the flange (outside the die opening and its fillet)."""
+    r = np.hypot(x_ref[:, 0], x_ref[:, 1])
+    return r > float(case.tools.die_opening_radius + case.tools.die_fillet)
+
+
+def flange_profile(x, deviation, radius: float, n_samples: int = 720):
+    """Deviation (m) along a circle of ``radius`` (m) about the punch axis, current configuration:
+    ``(angles (n,) rad, values (n,))``, linearly interpolated in the top view of the nodes ``x``
+    (give one ply's nodes; nearest node where the circle leaves the blank)."""
+    from scipy.interpolate import griddata
+
+    x = np.asarray(x, dtype=np.float64)
+    dev = np.asarray(deviation, dtype=np.float64)
+    th = np.linspace(0, 2 * np.pi, n_samples, endpoint=False)
+    pts = np.stack([radius * np.cos(th), radius * np.sin(th)], 1)
+    vals = griddata(x[:, :2], dev, pts, method="linear")
+    bad = ~np.isfinite(vals)
+    if np.any(bad):
+        vals[bad] = griddata(x[:, :2], dev, pts[bad], method="nearest")
+    return th, vals
+
+
+def wrinkle_count(x, deviation, case, *, radius: float | None = None, prominence: float = 0.5e-3,
+                  n_samples: int = 720) -> int:
+    """Number of discrete out-of-plane waves around the flange: peaks of the deviation along a
+    circle of ``radius`` (default 10 mm outside the die fillet) standing out by more than
+    ``prominence`` (m) from the troughs beside them. A flange lifted uniformly counts 0."""
+    from scipy.signal import find_peaks
+
+    rad = float(case.tools.die_opening_radius + case.tools.die_fillet) + 10e-3 if radius is None else radius
+    _, prof = flange_profile(x, deviation, rad, n_samples)
+    prof = np.round(prof, 9)  # no peaks from float noise on flat stretches
+    ext = np.concatenate([prof, prof, prof])
+    peaks, _ = find_peaks(ext, prominence=prominence)
+    return int(np.sum((peaks >= n_samples) & (peaks < 2 * n_samples)))
+
+
+def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
+    """Mirror symmetry of a nodal field about the x and y axes of the blank.
+
+    Returns ``{"x": e_x, "y": e_y}``: ``max |v - s v_mirror| / max |v|`` with the mirror node found
+    by reference position and ``s = -1`` for fields that change sign under a mirror (``odd``: the
+    shear angle of a 0/90° fabric), else 1.
+    """
+    x_ref = np.asarray(x_ref)
+    v = np.asarray(values)
+    sign = -1.0 if odd else 1.0
+    key = np.round(x_ref[:, :2] * 1e6).astype(np.int64)
+    lut = {(a, b): i for i, (a, b) in enumerate(map(tuple, key))}
+    out = {}
+    for name, sx, sy in (("x", 1, -1), ("y", -1, 1)):
+        idx = np.array([lut.get((sx * a, sy * b), i) for i, (a, b) in enumerate(map(tuple, key))])
+        out[name] = float(np.max(np.abs(v - sign * v[idx])) / max(np.max(np.abs(v)), 1e-30))
+    return out
+
+
+def summarize(result) -> dict:
+    """The summary of a :class:`~jaxform.forming.driver.FormingResult` (SPEC section 6 keys and more; JSON-ready)."""
+    import jaxform
+
+    info = result.info
+    case = info.case
+    h = result.history
+    ie = h["tension"] + h["shear"] + h["bending"] if len(h["t"]) else np.zeros(0)
+    ke = h["kinetic"] if len(h["t"]) else np.zeros(0)
+    T = info.stroke_time
+    late = h["t"] >= 0.2 * T if len(h["t"]) else np.zeros(0, bool)
+    ratio = np.where(ie > 0, ke / np.maximum(ie, 1e-300), np.inf) if len(ie) else ie
+    max_ke_ie = float(np.max(ratio[late])) if np.any(late) else None
+    if max_ke_ie is not None and not math.isfinite(max_ke_ie):
+        max_ke_ie = None  # no internal energy yet (JSON has no inf)
+    gam = result.fields.get("shear_angle")
+    max_shear = float(np.degrees(np.max(np.abs(gam)))) if gam is not None and gam.size else None
+    di = draw_in(result.x[-1], info) if len(result.x) else None
+    dev = result.fields.get("deviation")
+    flange = flange_mask(info.x0, case)
+    max_dev = float(np.max(dev[-1][flange])) if dev is not None and len(dev) else None
+    s = {
+        "complete": bool(result.complete),
+        "reason": result.reason,
+        "case": case.name,
+        "inputs": to_dict(case),
+        "numerics": {"dt_s": info.dt, "stable_dt_s": info.stable_dt, "n_steps": info.n_steps,
+                     "steps_done": int(h["step"][-1]) if len(h["step"]) else 0, "stroke_time_s": T,
+                     "nodes": int(len(info.x0)), "mass_scaling": float(case.mass_scaling),
+                     "fibre_mass_scaling": float(case.fibre_mass_scaling),
+                     # products with the fibre-tension stiffness per step: degree - 1
+                     "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
+                     "dtype": case.dtype,
+                     "punch_speed_m_per_s": float(case.process.speed)},
+        "max_ke_ie": max_ke_ie,
+        "max_shear_angle_deg": max_shear,
+        "max_flange_deviation_m": max_dev,
+        "flange_wrinkles": (wrinkle_count(result.x[-1][result.ply_id == 1], dev[-1][result.ply_id == 1], case)
+                            if dev is not None and len(dev) else None),
+        "draw_in": di,
+        "wall_time_s": result.wall_time_s,
+        "frames_written": int(len(result.t)),
+        "frame_times_s": result.t.tolist(),
+        "history": {
+            "t_s": h["t"].tolist(),
+            "punch_displacement_m": h["punch_displacement"].tolist(),
+            "punch_force_N": h["punch_force"].tolist(),
+            "holder_force_N": h["holder_force"].tolist(),
+            "energies_J": {k: h[k].tolist() for k in ENERGY_KEYS},
+            "internal_energy_J": ie.tolist(),
+            "ke_ie": [None if not np.isfinite(r) else float(r) for r in ratio],
+            "contact_energy_J": h["contact_energy"].tolist(),
+            "friction_power_W": h["friction_power"].tolist(),
+        },
+        "versions": {"jaxform": jaxform.__version__, "jax": jax.__version__, "numpy": np.__version__},
+    }
+    return s
+
+
+__all__ = ["draw_in", "flange_mask", "flange_profile", "wrinkle_count", "symmetry_error", "summarize"]

@@ -51,7 +51,13 @@ import jax.numpy as jnp
 
 from jaxform import tools, validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
-from jaxform.tools import closest_point_triangle, safe_norm, safe_normalize
+from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
+    closest_point_triangle,
+    nearest_centroids,
+    quads_to_triangles,
+    safe_norm,
+    safe_normalize,
+)
 
 
 @pytree_dataclass
@@ -207,19 +213,13 @@ def tool_pose(tool, t):
 # ---------------------------------------------------------------------------------------------
 
 
-def quads_to_triangles(faces):
-    """(F, 4) quads -> (2F, 3) triangles (split along the 0–2 diagonal); triangles pass through."""
-    faces = jnp.asarray(faces)
-    if faces.shape[1] == 3:
-        return faces
-    return jnp.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]], axis=0)
-
-
 def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
     """Candidate table for ply–ply contact: the ``k`` triangles with the nearest centroids.
 
-    Cost ``O(N_s F)`` (``chunk`` slave nodes at a time): refresh it every so many steps, not
-    every step (plies slide by less than an element between refreshes).
+    Cost ``O(N_s F)`` (``chunk`` slave nodes at a time, :func:`jaxform.geometry.nearest_centroids`):
+    refresh it every so many steps, not every step (plies slide by less than an element between
+    refreshes). The plies move, so the host-built certified index of
+    :func:`jaxform.geometry.closest_triangle` does not apply here.
 
     Args:
         x: (N, 3) all node positions, m.
@@ -231,20 +231,8 @@ def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
         (N_s, k) int32 triangle indices.
     """
     x = jnp.asarray(x)
-    tri = jnp.asarray(triangles)
-    cen = jnp.mean(x[tri], axis=1)
-    ps = x[jnp.asarray(slave)]
-    ns = ps.shape[0]
-    chunk = int(max(1, min(chunk, ns)))
-    pad = (-ns) % chunk
-    ps = jnp.concatenate([ps, jnp.zeros((pad, 3), ps.dtype)]).reshape(-1, chunk, 3)
-    k = int(min(k, tri.shape[0]))
-
-    def block(p):
-        d2 = jnp.sum((p[:, None, :] - cen[None, :, :]) ** 2, axis=-1)
-        return jax.lax.top_k(-d2, k)[1].astype(jnp.int32)
-
-    return jax.lax.map(block, ps).reshape(-1, k)[:ns]
+    cen = jnp.mean(x[jnp.asarray(triangles)], axis=1)
+    return nearest_centroids(x[jnp.asarray(slave)], cen, k, chunk)
 
 
 def _ply_node(p, vp, tri_x, tri_v, gap0, area, params):

@@ -45,6 +45,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
+from jaxform.geometry import safe_sqrt
 from jaxform.mesh import Mesh
 
 SHEAR_READINGS = ("a14", "conjugate")
@@ -134,7 +135,8 @@ def _cross(a, b):
 
 
 def _safe_norm(v):
-    return jnp.sqrt(_dot(v, v) + jnp.finfo(v.dtype).tiny)
+    """Norm of structure-of-arrays vectors (3, ...), zero gradient at zero (:mod:`jaxform.geometry`)."""
+    return safe_sqrt(_dot(v, v))
 
 
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on
@@ -166,7 +168,7 @@ def _fibres_soa(e1, e2, coef):
 
 def _angle(g1, g2):
     cr = _cross(g1, g2)
-    return jnp.arctan2(jnp.sqrt(_dot(cr, cr) + jnp.finfo(g1.dtype).tiny), _dot(g1, g2))
+    return jnp.arctan2(_safe_norm(cr), _dot(g1, g2))
 
 
 def fibre_vectors(x, mesh: Mesh, ref: ShellRef):

@@ -29,8 +29,8 @@ die's entry fillet, and its exit edge with the same radius, which the fabric nev
 Triangle-mesh tools are sampled once, host side, into a :class:`GridSDF` (see
 :mod:`jaxform.io.tool_mesh`), evaluated here by trilinear interpolation.
 
-The point–triangle routine at the end (:func:`closest_point_triangle`) is shared by the mesh
-sampler and ply–ply contact.
+Safe norms and the point–triangle routine live in :mod:`jaxform.geometry` (``safe_norm``,
+``safe_normalize`` and ``closest_point_triangle`` are re-exported here for old imports).
 """
 from __future__ import annotations
 
@@ -42,29 +42,9 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform import validate
-from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass
-
-_EZ = (0.0, 0.0, 1.0)
-
-
-# ---------------------------------------------------------------------------------------------
-# Safe vector helpers (finite gradients at zero, STYLE habit 5)
-# ---------------------------------------------------------------------------------------------
-
-
-def safe_norm(v, axis=-1):
-    """Euclidean norm along ``axis`` whose gradient is 0 (not NaN) at the zero vector."""
-    s = jnp.sum(v * v, axis=axis)
-    ok = s > 0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, s, 1.0)), 0.0)
-
-
-def safe_normalize(v, fallback=_EZ, tiny=1e-30):
-    """Unit vector along ``v`` (..., 3); ``fallback`` where ``|v|`` is (nearly) zero."""
-    s = jnp.sum(v * v, axis=-1, keepdims=True)
-    ok = s > tiny
-    unit = v / jnp.sqrt(jnp.where(ok, s, 1.0))
-    return jnp.where(ok, unit, jnp.asarray(fallback, dtype=unit.dtype))
+from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
+from jaxform.geometry import EZ as _EZ
+from jaxform.geometry import closest_point_triangle, safe_norm, safe_normalize  # noqa: F401  (re-exported)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -165,15 +145,23 @@ def _rounded_halfstrip(r, z, r_in, z_lo, z_hi, radius):
 class Punch:
     """Hemispherical punch, apex down, on a cylindrical shank of the same radius going up (to +inf).
 
+    With ``apex_up`` the shape is mirrored about ``z = apex_z``: apex up, shank going down (a male
+    mould seen from the formed part, as in the wrinkle metric's hemisphere rig,
+    :func:`hemisphere_rig`).
+
     Attributes:
         radius: hemisphere and shank radius ``R``, m (SPEC default 50 mm).
         apex_z: height of the apex in the reference pose, m.
         motion: :class:`VerticalMotion` (punch travel; negative velocity pushes the fabric down).
+        apex_up: mirror the punch (static; default False: apex down, the forming rig).
+        axis_xy: (2,) position of the punch axis in the xy plane, m (default ``None``: the z axis).
     """
 
     radius: Any
     apex_z: Any = 0.0
     motion: Any = STILL
+    apex_up: bool = static_field(default=False)
+    axis_xy: Any = None
 
     def __post_init__(self):
         if is_concrete(self.radius, self.apex_z):
@@ -181,9 +169,19 @@ class Punch:
             validate.finite("Punch", "apex_z", self.apex_z, "m")
             object.__setattr__(self, "radius", as_leaf(self.radius))
             object.__setattr__(self, "apex_z", as_leaf(self.apex_z))
+        if self.axis_xy is not None and is_concrete(self.axis_xy):
+            if np.shape(self.axis_xy) != (2,):
+                raise ValueError(f"Punch.axis_xy: shape {np.shape(self.axis_xy)}: need (2,) (m)")
+            validate.finite("Punch", "axis_xy", self.axis_xy, "m")
+            object.__setattr__(self, "axis_xy", as_leaf(self.axis_xy))
 
     def phi_local(self, p):
         """Signed distance, m, of one point (3,) in the reference pose."""
+        if self.axis_xy is not None:
+            axis = jnp.asarray(self.axis_xy, p.dtype)
+            p = jnp.stack([p[0] - axis[0], p[1] - axis[1], p[2]])
+        if self.apex_up:
+            p = jnp.stack([p[0], p[1], 2.0 * self.apex_z - p[2]])
         c = jnp.stack([0.0 * p[0], 0.0 * p[1], self.apex_z + self.radius + 0.0 * p[2]])
         d = p - c
         sphere = safe_norm(d) - self.radius
@@ -393,7 +391,7 @@ class GridSDF:
 
 
 def _phi_normal_one(tool, p):
-    if hasattr(tool, "phi_normal_local"):
+    if isinstance(tool, GridSDF):
         return tool.phi_normal_local(p)
     phi, g = jax.value_and_grad(tool.phi_local)(p)
     return phi, safe_normalize(g)
@@ -416,6 +414,52 @@ def sdf(tool, points, dz=0.0):
     points = jnp.asarray(points)
     shift = jnp.zeros(3, points.dtype).at[2].set(jnp.asarray(dz, points.dtype))
     return jax.vmap(lambda p: _phi_normal_one(tool, p - shift))(points)
+
+
+def union_sdf(tools, points, dz=0.0):
+    """Signed distance and outward normal of ``points`` to the union of several tools.
+
+    ``phi = min_i phi_i`` (the normal of the nearest tool): exact outside every tool and inside
+    a single one; where tools overlap it is a bound (the distance to the nearer tool's surface).
+    The unsigned distance to the rig's surface is ``|phi|``.
+
+    Args:
+        tools: a sequence of tool pytrees (see :func:`sdf`), or one tool.
+        points: (N, 3) positions, m.
+        dz: vertical displacement of all the tools, m (scalar).
+
+    Returns:
+        ``(phi, normal)``: (N,) m; (N, 3) unit.
+    """
+    if not isinstance(tools, (tuple, list)):
+        return sdf(tools, points, dz)
+    phis, normals = zip(*(sdf(t, points, dz) for t in tools))
+    phi = jnp.stack(phis)  # (T, N)
+    j = jnp.argmin(phi, axis=0)
+    normal = jnp.take_along_axis(jnp.stack(normals), j[None, :, None], axis=0)[0]
+    return jnp.min(phi, axis=0), normal
+
+
+def hemisphere_rig(radius=0.05, center=(0.0, 0.0, 0.0), base_plane: bool = True) -> tuple:
+    """The wrinkle metric's hemisphere rig: a hemisphere, apex up, standing on a flat base plane.
+
+    The surface is the upper half-sphere ``|x - c| = R, z >= c_z`` and (with ``base_plane``) the
+    plane ``z = c_z`` outside the circle of radius ``R``: the paper's punch seen from the formed
+    part. Without the base plane the hemisphere continues downwards as the punch's shank.
+
+    Args:
+        radius: hemisphere radius ``R``, m (default 50 mm).
+        center: (3,) centre of the sphere, on the base plane, m.
+        base_plane: include the flat base plane.
+
+    Returns:
+        A tuple of tools for :func:`union_sdf`: ``(Punch(apex up), Plane)`` or ``(Punch,)``.
+    """
+    c = center if isinstance(center, (tuple, list)) else jnp.asarray(center)
+    punch = Punch(radius, apex_z=c[2] + radius, apex_up=True, axis_xy=(c[0], c[1]))
+    if not base_plane:
+        return (punch,)
+    return (punch, Plane(point=c, normal=_EZ))
 
 
 def displacement(tool, t):
@@ -445,57 +489,6 @@ class FormingTools:
     holder: Any
 
 
-# ---------------------------------------------------------------------------------------------
-# Point–triangle geometry (shared by mesh sampling and ply–ply contact)
-# ---------------------------------------------------------------------------------------------
-
-
-def closest_point_triangle(p, a, b, c):
-    """Closest point of triangle ``abc`` to ``p`` and its barycentric weights (Voronoi regions).
-
-    Args:
-        p, a, b, c: (3,) points, m.
-
-    Returns:
-        ``(q, w)``: (3,) closest point, m; (3,) barycentric weights of ``q`` (sum 1, >= 0).
-        Degenerate triangles are handled (the result is then a closest point of an edge/vertex).
-    """
-    ab, ac, ap = b - a, c - a, p - a
-    d1, d2 = jnp.dot(ab, ap), jnp.dot(ac, ap)
-    bp = p - b
-    d3, d4 = jnp.dot(ab, bp), jnp.dot(ac, bp)
-    cp = p - c
-    d5, d6 = jnp.dot(ab, cp), jnp.dot(ac, cp)
-    va = d3 * d6 - d5 * d4
-    vb = d5 * d2 - d1 * d6
-    vc = d1 * d4 - d3 * d2
-
-    def sdiv(x, y):
-        ok = jnp.abs(y) > 0
-        return jnp.where(ok, x / jnp.where(ok, y, 1.0), 0.0)
-
-    one, zero = jnp.ones_like(d1), jnp.zeros_like(d1)
-    # Face interior.
-    den = va + vb + vc
-    v_f, w_f = sdiv(vb, den), sdiv(vc, den)
-    w = jnp.stack([1.0 - v_f - w_f, v_f, w_f])
-    # Edge bc.
-    t_bc = jnp.clip(sdiv(d4 - d3, (d4 - d3) + (d5 - d6)), 0.0, 1.0)
-    w = jnp.where((va <= 0) & (d4 - d3 >= 0) & (d5 - d6 >= 0), jnp.stack([zero, 1.0 - t_bc, t_bc]), w)
-    # Edge ac.
-    t_ac = jnp.clip(sdiv(d2, d2 - d6), 0.0, 1.0)
-    w = jnp.where((vb <= 0) & (d2 >= 0) & (d6 <= 0), jnp.stack([1.0 - t_ac, zero, t_ac]), w)
-    # Edge ab.
-    t_ab = jnp.clip(sdiv(d1, d1 - d3), 0.0, 1.0)
-    w = jnp.where((vc <= 0) & (d1 >= 0) & (d3 <= 0), jnp.stack([1.0 - t_ab, t_ab, zero]), w)
-    # Vertices.
-    w = jnp.where((d6 >= 0) & (d5 <= d6), jnp.stack([zero, zero, one]), w)
-    w = jnp.where((d3 >= 0) & (d4 <= d3), jnp.stack([zero, one, zero]), w)
-    w = jnp.where((d1 <= 0) & (d2 <= 0), jnp.stack([one, zero, zero]), w)
-    q = w[0] * a + w[1] * b + w[2] * c
-    return q, w
-
-
 __all__ = [
     "VerticalMotion",
     "STILL",
@@ -506,6 +499,8 @@ __all__ = [
     "GridSDF",
     "FormingTools",
     "sdf",
+    "union_sdf",
+    "hemisphere_rig",
     "displacement",
     "velocity",
     "safe_norm",

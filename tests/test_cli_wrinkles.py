@@ -46,10 +46,10 @@ def test_wrinkles_command_on_a_mesh_in_mm(sheet_mm, tmp_out, capsys):
 
 
 def test_tool_mesh_and_point_cloud(sheet_mm, tmp_path, capsys):
-    from jaxform.metrics import HemisphereRig
+    from jaxform.io.tool_mesh import hemisphere_rig_mesh
 
     path, x, f, _ = sheet_mm
-    tv, tf = HemisphereRig().mesh(0.002, extent=0.06)
+    tv, tf = hemisphere_rig_mesh(size=0.002, extent=0.06)
     tool_path = tmp_path / "tool.stl"
     meshio.write(tool_path, meshio.Mesh(tv * 1e3, [("triangle", tf)]))
     # a "scan": points 0.2 mm outside the simulated surface, along the sphere's radius (the

@@ -10,8 +10,9 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform.metrics import HemisphereRig, PlaneTool, ToolWarning, tool_distance
-from jaxform.metrics.distance import build_tool_index
+from jaxform import tools
+from jaxform.io.tool_mesh import hemisphere_rig_mesh
+from jaxform.metrics import ToolWarning, build_tool_index, tool_distance
 
 
 def _ericson_closest(p, a, b, c):
@@ -56,12 +57,12 @@ def brute_distance(nodes, verts, faces):
 
 @pytest.fixture(scope="module")
 def small_tool():
-    return HemisphereRig().mesh(0.008)
+    return hemisphere_rig_mesh(size=0.008)
 
 
 @pytest.fixture(scope="module")
 def tool20k():
-    v, f = HemisphereRig().mesh(0.002)
+    v, f = hemisphere_rig_mesh(size=0.002)
     assert 19_000 <= len(f) <= 22_000
     return v, f
 
@@ -140,33 +141,43 @@ def test_distance_gradient_finite_on_the_surface():
 
 
 def test_hemisphere_rig_closed_form():
-    rig = HemisphereRig(radius=0.05)
+    rig = tools.hemisphere_rig(radius=0.05)
     x = np.array([
         [0.0, 0.0, 0.08],     # above the pole: 30 mm
         [0.0, 0.0, 0.0],      # centre of the sphere: R
         [0.1, 0.0, 0.004],    # over the base plane: 4 mm
         [0.03, 0.04, 0.0],    # rim circle
-        [0.02, 0.0, -0.01],   # below the plane inside the rim: to the rim circle
         [0.04, 0.0, 0.03],    # on the cap
+        [0.06, 0.0, -0.002],  # below the base plane, outside the rim: 2 mm
     ])
-    d = np.asarray(rig.distance(x))
-    np.testing.assert_allclose(d, [0.03, 0.05, 0.004, 0.0, np.hypot(0.03, 0.01), 0.0], atol=1e-15)
-    g = jax.grad(lambda y: jnp.sum(rig.distance(y)))(x)
+    d = np.asarray(tool_distance(x, rig))
+    np.testing.assert_allclose(d, [0.03, 0.05, 0.004, 0.0, 0.0, 0.002], atol=1e-15)
+    g = jax.grad(lambda y: jnp.sum(tool_distance(y, rig)))(x)
     assert np.all(np.isfinite(np.asarray(g)))
-    # The same through tool_distance, and agreement with a fine mesh of the rig.
-    np.testing.assert_allclose(np.asarray(tool_distance(x, rig)), d)
-    v, f = rig.mesh(0.002, extent=0.12)
+    # Off the z axis, and agreement with a fine mesh of the rig (nodes outside the tool).
+    c = np.array([0.01, -0.02, 0.003])
+    np.testing.assert_allclose(np.asarray(tool_distance(x + c, tools.hemisphere_rig(0.05, tuple(c)))), d,
+                               atol=1e-15)
+    v, f = hemisphere_rig_mesh(0.05, size=0.002, extent=0.12)
     x2 = _query_points(np.random.default_rng(5), 300)
-    x2 = x2[np.hypot(x2[:, 0], x2[:, 1]) < 0.11]
+    x2 = x2[(np.hypot(x2[:, 0], x2[:, 1]) < 0.11) & (x2[:, 2] > 0.0) & (np.linalg.norm(x2, axis=1) > 0.05)]
     dm = np.asarray(tool_distance(x2, v, f))
     # chordal error of a 2 mm faceting of a 50 mm sphere: about s^2/(8R) ~ 1e-5 m
-    np.testing.assert_allclose(np.asarray(rig.distance(x2)), dm, atol=3e-5)
+    np.testing.assert_allclose(np.asarray(tool_distance(x2, rig)), dm, atol=3e-5)
 
 
-def test_plane_tool():
+def test_analytic_tools_and_their_union():
     x = np.array([[1.0, 2.0, 0.003], [0.0, 0.0, -0.002]])
-    np.testing.assert_allclose(np.asarray(PlaneTool().distance(x)), [0.003, 0.002])
-    np.testing.assert_allclose(np.asarray(PlaneTool(normal=(0.0, 0.0, 5.0)).distance(x)), [0.003, 0.002])
+    np.testing.assert_allclose(np.asarray(tool_distance(x, tools.Plane(point=(0.0, 0.0, 0.0)))), [0.003, 0.002])
+    tilted = tools.Plane(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 5.0))
+    np.testing.assert_allclose(np.asarray(tool_distance(x, [tilted])), [0.003, 0.002])
+    # The forming rig at its reference pose: distance to the nearest of punch, die and holder.
+    rig = tools.FormingTools(punch=tools.Punch(0.05, apex_z=0.01), die=tools.Die(0.053, 0.006),
+                             holder=tools.BlankHolder(0.053, bottom_z=0.004))
+    y = np.array([[0.0, 0.0, 0.007], [0.08, 0.0, 0.001], [0.08, 0.0, 0.0035]])
+    np.testing.assert_allclose(np.asarray(tool_distance(y, rig)), [0.003, 0.001, 0.0005], atol=1e-15)
+    with pytest.raises(ValueError, match="tool_faces is required"):
+        tool_distance(x, np.zeros((3, 3)))
 
 
 def test_bad_input_is_refused_or_warned():

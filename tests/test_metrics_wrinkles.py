@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from _surfaces import grid_faces
+from jaxform.tools import hemisphere_rig
 from jaxform.metrics import (
     BRIDGING,
     CONFORMING,
     WRINKLE,
-    HemisphereRig,
     classify_zones,
     count_section_wrinkles,
     count_wrinkle_regions,
@@ -56,7 +56,7 @@ def test_d_crit():
 
 def test_zones_on_constructed_case():
     x, f, bump, lift = draped_sheet()
-    d = np.asarray(tool_distance(x, HemisphereRig(radius=R)))
+    d = np.asarray(tool_distance(x, hemisphere_rig(radius=R)))
     np.testing.assert_allclose(d[(bump == 0) & (lift == 0)], 0.45 * H_PLY, atol=1e-12)
     km = kappa_max(*principal_curvatures(x, f))
     labels = np.asarray(classify_zones(d, km, d_crit(H_PLY), kappa_threshold=100.0, faces=f))
@@ -76,7 +76,7 @@ def test_zones_on_constructed_case():
     assert np.all(np.asarray(region)[labels == WRINKLE] == np.asarray(region)[labels == WRINKLE][0])
     # Per-frame evaluation vmaps: the sheet pushed 1 mm further out is all bridging/defect.
     frames = jnp.stack([jnp.asarray(x), jnp.asarray(x) * (1 + 0.001 / R)])
-    lab2 = jax.vmap(lambda y: classify_zones(tool_distance(y, HemisphereRig(radius=R)),
+    lab2 = jax.vmap(lambda y: classify_zones(tool_distance(y, hemisphere_rig(radius=R)),
                                              kappa_max(*principal_curvatures(y, f)),
                                              d_crit(H_PLY), faces=f))(frames)
     np.testing.assert_array_equal(np.asarray(lab2[0]), labels)
@@ -111,7 +111,7 @@ def test_section_profile_interpolates_on_the_projected_surface():
 
 def test_section_over_the_draped_sheet_sees_both_defects_and_the_nrmse():
     x, f, bump, lift = draped_sheet()
-    d = tool_distance(x, HemisphereRig(radius=R))
+    d = tool_distance(x, hemisphere_rig(radius=R))
     pos, amp, valid, _ = section_profile(x, f, d, (-0.034, 0.0), (0.034, 0.0), 341)
     amp = np.asarray(amp)
     assert np.all(np.asarray(valid))

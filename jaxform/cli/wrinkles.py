@@ -47,8 +47,9 @@ def add_parser(subparsers) -> None:
 
 
 def _parse_tool(spec: str, units: str):
+    """The tool as ``(vertices, faces)`` of a mesh file, or a tuple of :mod:`jaxform.tools` tools."""
+    from jaxform import tools
     from jaxform.io.surface import read_surface
-    from jaxform.metrics import HemisphereRig, PlaneTool
 
     path = pathlib.Path(spec)
     if path.exists():
@@ -69,15 +70,16 @@ def _parse_tool(spec: str, units: str):
         bad = set(params) - allowed
         if bad:
             raise ValueError(f"unknown hemisphere parameters {sorted(bad)}; allowed: {sorted(allowed)}")
-        tool = HemisphereRig(radius=params.get("radius_mm", 50.0) * 1e-3,
-                             center=tuple(params.get(k, 0.0) * 1e-3 for k in ("x_mm", "y_mm", "z_mm")),
-                             base_plane=bool(params.get("base", 1.0)))
-        return tool, f"hemisphere rig, punch radius {tool.radius * 1e3:g} mm"
+        radius_mm = params.get("radius_mm", 50.0)
+        rig = tools.hemisphere_rig(radius_mm * 1e-3,
+                                   tuple(params.get(k, 0.0) * 1e-3 for k in ("x_mm", "y_mm", "z_mm")),
+                                   base_plane=bool(params.get("base", 1.0)))
+        return rig, f"hemisphere rig, punch radius {radius_mm:g} mm"
     if name == "plane":
         bad = set(params) - {"z_mm"}
         if bad:
             raise ValueError(f"unknown plane parameters {sorted(bad)}; allowed: ['z_mm']")
-        return PlaneTool(point=(0.0, 0.0, params.get("z_mm", 0.0) * 1e-3)), "plane"
+        return (tools.Plane(point=(0.0, 0.0, params.get("z_mm", 0.0) * 1e-3)),), "plane"
     raise ValueError(f"--tool {spec!r} is neither an existing file nor a preset "
                      f"({', '.join(PRESETS)})")
 
@@ -101,6 +103,7 @@ def run(args) -> int:
     import jax.numpy as jnp
 
     from jaxform import metrics as M
+    from jaxform.geometry import quads_to_triangles
     from jaxform.io.surface import read_point_cloud, read_surface, write_vtu
     from jaxform.plots import wrinkles as P
 
@@ -114,7 +117,7 @@ def run(args) -> int:
     tool, tool_text = _parse_tool(args.tool, args.tool_units)
     _check_out(out, args.force)
 
-    if isinstance(tool, tuple):
+    if isinstance(tool[0], np.ndarray):  # a mesh file: (vertices, faces)
         tv, tf = tool
         span_m = np.linalg.norm(np.ptp(nodes, axis=0))
         span_t = np.linalg.norm(np.ptp(tv, axis=0))
@@ -185,8 +188,7 @@ def run(args) -> int:
         summary["sections"] = sections
     if args.cloud:
         cloud = read_point_cloud(args.cloud, units=args.cloud_units)
-        tri = faces if faces.shape[1] == 3 else np.concatenate([faces[:, [0, 1, 2]], faces[:, [0, 2, 3]]])
-        cd = np.asarray(M.tool_distance(cloud, nodes, tri))
+        cd = np.asarray(M.tool_distance(cloud, nodes, np.asarray(quads_to_triangles(faces))))
         written.append(write_vtu(out / "cloud_distance.vtu", cloud, None,
                                  point_data={"distance_to_surface_m": cd}))
         written.append(P.plot_node_field(out / "cloud_distance.png", cloud, None, cd, scale=1e3,

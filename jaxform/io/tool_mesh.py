@@ -10,9 +10,13 @@ curve of radius ``R`` cut into ``n`` segments per half turn) plus the interpolat
 about ``cell**2 / (8 R)`` for a surface of curvature radius ``R`` (0.04 mm for 4 mm cells on the
 50 mm punch). ``tests/test_tools.py`` checks a capsule mesh against the analytic punch.
 
-Cost. Sampling uses a k-d tree over the (subdivided) triangles, ``O(grid points x k)``: about a
-second per 1e5 grid points on a CPU. Keep the box tight around the part of the tool the fabric
-can touch and the cell about the element size.
+Cost. Sampling uses the certified cluster search of :mod:`jaxform.geometry` (a few hundred
+point-triangle tests per grid point; more for points deep inside a solid, near its medial axis).
+Keep the box tight around the part of the tool the fabric can touch and the cell about the element
+size.
+
+:func:`hemisphere_rig_mesh` meshes the wrinkle metric's analytic hemisphere rig (for plots and
+files).
 """
 from __future__ import annotations
 
@@ -22,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from jaxform import units
+from jaxform.geometry import build_triangle_index, closest_point_on_mesh
 from jaxform.tools import STILL, GridSDF
 
 _UNITS = {"m": 1.0, "mm": units.MM, "cm": 1.0e-2, "in": 0.0254}
@@ -85,17 +90,13 @@ def _checked(mesh, where, scale, require_watertight):
 
 
 def grid_sdf_from_mesh(vertices, faces, *, cell: float, lo=None, hi=None, padding: float | None = None,
-                       motion=STILL, k: int = 24) -> GridSDF:
+                       motion=STILL) -> GridSDF:
     """Sample the signed distance of a closed triangle mesh on a regular grid.
 
-    Method: the mesh is first subdivided (watertight, no T-junctions) until every edge is shorter
-    than ``cell``; for each grid point the ``k`` triangles with the nearest centroids (k-d tree) are
-    searched exactly (:func:`jaxform.tools.closest_point_triangle`). The result is *certified exact*
-    where the k-th centroid is farther than the distance found plus the largest triangle radius;
-    uncertified points within ``3 * cell`` of the surface are searched again with ``8 k``
-    candidates; elsewhere the error is at most the largest triangle radius (< ``cell``). The sign is
-    that of ``(p - q) . N`` with ``N`` the angle-weighted pseudo-normal of the closest feature
-    (face, edge or vertex: Baerentzen & Aanaes), exact for a closed, consistently oriented mesh.
+    Method: for each grid point the closest point of the mesh is found by the certified search of
+    :func:`jaxform.geometry.closest_point_on_mesh` (exact for every point). The sign is that of
+    ``(p - q) . N`` with ``N`` the angle-weighted pseudo-normal of the closest feature (face, edge
+    or vertex: Baerentzen & Aanaes), exact for a closed, consistently oriented mesh.
 
     Args:
         vertices: (V, 3) m; faces: (F, 3) int, closed and outward oriented (see
@@ -104,13 +105,10 @@ def grid_sdf_from_mesh(vertices, faces, *, cell: float, lo=None, hi=None, paddin
         lo, hi: (3,) corners of the sampled box, m; default: the mesh's bounding box grown by
             ``padding`` (default ``4 * cell``).
         motion: the tool's :class:`jaxform.tools.VerticalMotion`.
-        k: candidate triangles per point.
 
     Returns:
         :class:`jaxform.tools.GridSDF` with ``phi`` (nx, ny, nz) m and ``grad`` (nx, ny, nz, 3).
     """
-    import trimesh
-
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
     if not (isinstance(cell, (int, float)) and cell > 0 and math.isfinite(cell)):
@@ -123,8 +121,7 @@ def grid_sdf_from_mesh(vertices, faces, *, cell: float, lo=None, hi=None, paddin
     shape = tuple(int(math.ceil((h - l) / cell - 1e-9)) + 1 for l, h in zip(lo, hi))
     axes = [l + cell * np.arange(n) for l, n in zip(lo, shape)]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
-    v, f = trimesh.remesh.subdivide_to_size(vertices, faces, max_edge=cell, max_iter=30)
-    phi, grad = signed_distance(np.asarray(v), np.asarray(f), grid, k=k, band=3.0 * cell)
+    phi, grad = signed_distance(vertices, faces, grid)
     return GridSDF(
         phi=phi.reshape(shape),
         grad=grad.reshape(shape + (3,)),
@@ -134,92 +131,62 @@ def grid_sdf_from_mesh(vertices, faces, *, cell: float, lo=None, hi=None, paddin
     )
 
 
-_CLOSEST = None
-
-
-def _closest_candidates(points, A, B, C, idx, step: int = 8192):
-    """Closest points ``q`` (N, k, 3) and barycentric weights (N, k, 3) on candidate triangles."""
-    global _CLOSEST
-    import jax
-    import jax.numpy as jnp
-
-    from jaxform.tools import closest_point_triangle
-
-    if _CLOSEST is None:
-        _CLOSEST = jax.jit(jax.vmap(jax.vmap(closest_point_triangle, in_axes=(None, 0, 0, 0))))
-    n = points.shape[0]
-    step = min(step, n)
-    out_q, out_w = [], []
-    for s in range(0, n, step):
-        i = idx[s:s + step]
-        p = points[s:s + step]
-        m = len(p)
-        if m < step:  # pad to a fixed chunk shape: one compilation
-            p = np.concatenate([p, np.repeat(p[-1:], step - m, 0)])
-            i = np.concatenate([i, np.repeat(i[-1:], step - m, 0)])
-        q, w = _CLOSEST(jnp.asarray(p), jnp.asarray(A[i]), jnp.asarray(B[i]), jnp.asarray(C[i]))
-        out_q.append(np.asarray(q)[:m])
-        out_w.append(np.asarray(w)[:m])
-    return np.concatenate(out_q), np.concatenate(out_w)
-
-
-def signed_distance(vertices, faces, points, *, k: int = 24, band: float = 0.0):
+def signed_distance(vertices, faces, points, *, index=None):
     """Signed distance (N,) m and unit gradient (N, 3) of a closed mesh at ``points`` (N, 3), host side.
 
-    See :func:`grid_sdf_from_mesh` for the method and its guarantees (``band``: distance within
-    which uncertified points get a wider search).
+    See :func:`grid_sdf_from_mesh` for the method. ``index``: the mesh's
+    :class:`jaxform.geometry.TriangleIndex` when the caller already has one (built here otherwise).
     """
-    from scipy.spatial import cKDTree
-
     vertices = np.asarray(vertices, dtype=np.float64)
     faces = np.asarray(faces, dtype=np.int64)
     points = np.asarray(points, dtype=np.float64)
+    if index is None:
+        index = build_triangle_index(vertices, faces)
+    q, w, ids = (np.asarray(a) for a in closest_point_on_mesh(points, index))
+    qd = points - q
+    dmin = np.sqrt(np.sum(qd * qd, axis=1))
+    pseudo = _feature_pseudo_normals(vertices, faces)(ids, w)
+    sign = np.where(np.sum(qd * pseudo, axis=1) < 0, -1.0, 1.0)
+    scale = float(np.max(np.ptp(vertices, axis=0)))
+    on_surface = dmin <= 1e-12 * max(scale, 1.0)
+    pn = pseudo / np.maximum(np.linalg.norm(pseudo, axis=1, keepdims=True), 1e-300)
+    grad = np.where(on_surface[:, None], pn, sign[:, None] * qd / np.maximum(dmin, 1e-300)[:, None])
+    return sign * dmin, grad
+
+
+def _feature_pseudo_normals(vertices, faces):
+    """The angle-weighted pseudo-normal of the closest feature (Baerentzen & Aanaes).
+
+    Returns a function of the closest triangle ids (N,) and barycentric weights (N, 3): the
+    face normal inside a face, the sum of the two face normals on an edge, the angle-weighted sum
+    of the face normals around a vertex (the weights are exactly one-hot / zero in the vertex and
+    edge regions of :func:`jaxform.geometry.closest_point_triangle`)."""
     A, B, C = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
     nrm = np.cross(B - A, C - A)
     nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
     ang = np.stack([_angle(B - A, C - A), _angle(C - B, A - B), _angle(A - C, B - C)], axis=1)
-    cen = (A + B + C) / 3.0
-    rad = np.max(np.linalg.norm(np.stack([A, B, C]) - cen, axis=-1), axis=0)
-    tree = cKDTree(cen)
-    nf = faces.shape[0]
+    vertex_n = np.zeros_like(vertices)
+    for j in range(3):
+        np.add.at(vertex_n, faces[:, j], ang[:, j, None] * nrm)
+    # Edge j of a face is the one opposite corner j; both faces of an edge add their normal.
+    opposite = np.stack([faces[:, [1, 2]], faces[:, [2, 0]], faces[:, [0, 1]]], axis=1)  # (F, 3, 2)
+    keys = np.sort(opposite, axis=-1).reshape(-1, 2)
+    _, edge_id = np.unique(keys, axis=0, return_inverse=True)
+    edge_id = edge_id.reshape(-1)
+    edge_n = np.zeros((edge_id.max() + 1, 3))
+    np.add.at(edge_n, edge_id, np.repeat(nrm, 3, axis=0))
+    edge_id = edge_id.reshape(-1, 3)
 
-    def search(pts, kk):
-        kk = int(min(kk, nf))
-        dc, idx = tree.query(pts, k=kk)
-        dc, idx = dc.reshape(len(pts), kk), idx.reshape(len(pts), kk)
-        q, w = _closest_candidates(pts, A, B, C, idx)
-        d = np.linalg.norm(q - pts[:, None, :], axis=-1)
-        best = np.argmin(d, axis=1)
-        dmin = d[np.arange(len(pts)), best]
-        certified = (kk == nf) | (dc[:, -1] >= dmin + rad.max())
-        return idx, q, w, d, best, dmin, certified
+    def pseudo(ids, w):
+        corner = np.argmax(w, axis=1)
+        gone = np.argmin(w, axis=1)
+        at_vertex = np.max(w, axis=1) == 1.0
+        on_edge = ~at_vertex & (np.min(w, axis=1) == 0.0)
+        out = nrm[ids]
+        out = np.where(on_edge[:, None], edge_n[edge_id[ids, gone]], out)
+        return np.where(at_vertex[:, None], vertex_n[faces[ids, corner]], out)
 
-    idx, q, w, d, best, dmin, ok = search(points, k)
-    redo = np.flatnonzero(~ok & (dmin < band))
-    if redo.size:
-        r = search(points[redo], 8 * k)
-        kk = r[0].shape[1]
-        pad = lambda a, fill: np.concatenate([a, np.full(a.shape[:1] + (kk - a.shape[1],) + a.shape[2:], fill, a.dtype)], 1)
-        idx, d = pad(idx, 0), pad(d, np.inf)
-        q, w = pad(q, 0.0), pad(w, 0.0)
-        idx[redo], q[redo], w[redo], d[redo], best[redo], dmin[redo] = r[:6]
-    n = len(points)
-    scale = float(np.max(np.ptp(vertices, axis=0)))
-    qb = q[np.arange(n), best]
-    # The closest *feature* may be shared by several triangles (an edge, a vertex): those whose
-    # closest point is the same point. (Equal distances to different points, on the medial axis,
-    # are not ties.)
-    tie = np.linalg.norm(q - qb[:, None, :], axis=-1) <= 1e-9 * scale
-    corner = np.argmax(w, axis=-1)
-    at_vertex = np.max(w, axis=-1) > 1.0 - 1e-9
-    weight = np.where(at_vertex, ang[idx, corner], 1.0) * tie
-    pseudo = np.sum(weight[..., None] * nrm[idx], axis=1)
-    diff = points - qb
-    sign = np.where(np.sum(diff * pseudo, axis=1) < 0, -1.0, 1.0)
-    on_surface = dmin <= 1e-12 * max(scale, 1.0)
-    pn = pseudo / np.maximum(np.linalg.norm(pseudo, axis=1, keepdims=True), 1e-300)
-    grad = np.where(on_surface[:, None], pn, sign[:, None] * diff / np.maximum(dmin, 1e-300)[:, None])
-    return sign * dmin, grad
+    return pseudo
 
 
 def _angle(u, v):
@@ -234,4 +201,79 @@ def load_tool_sdf(path, *, cell: float, units: str = "mm", padding: float | None
     return grid_sdf_from_mesh(vertices, faces, cell=cell, lo=lo, hi=hi, padding=padding, motion=motion)
 
 
-__all__ = ["load_tool_mesh", "mesh_arrays", "grid_sdf_from_mesh", "signed_distance", "load_tool_sdf"]
+def hemisphere_rig_mesh(radius: float = 0.05, center=(0.0, 0.0, 0.0), size: float = 0.002,
+                        extent: float | None = None, base_plane: bool = True):
+    """A triangle mesh of :func:`jaxform.tools.hemisphere_rig` for plots and files (numpy).
+
+    Args:
+        radius: hemisphere radius, m; center: (3,) sphere centre on the base plane, m.
+        size: target edge length, m.
+        extent: outer radius of the base-plane annulus, m (default 2.5 ``radius``).
+        base_plane: mesh the base plane too.
+
+    Returns:
+        ``(vertices (V, 3) m, faces (F, 3) int64)``.
+    """
+    radius = float(radius)
+    center = np.asarray(center, dtype=np.float64)
+    extent = 2.5 * radius if extent is None else float(extent)
+    # Cap: rings of latitude from the pole to the equator.
+    n_lat = max(2, int(np.ceil(0.5 * np.pi * radius / size)))
+    verts = [center + [0, 0, radius]]
+    faces = []
+    prev = [0]
+    for i in range(1, n_lat + 1):
+        th = 0.5 * np.pi * i / n_lat
+        n_ring = max(6, int(np.ceil(2 * np.pi * radius * np.sin(th) / size)))
+        phi = 2 * np.pi * np.arange(n_ring) / n_ring
+        start = len(verts)
+        verts.extend(center + np.stack([radius * np.sin(th) * np.cos(phi),
+                                        radius * np.sin(th) * np.sin(phi),
+                                        np.full(n_ring, radius * np.cos(th))], 1))
+        cur = list(range(start, start + n_ring))
+        faces.extend(_stitch(prev, cur))
+        prev = cur
+    verts = np.asarray(verts)
+    faces = np.asarray(faces, np.int64)
+    if not base_plane:
+        return verts, faces
+    # Base plane: an annulus from the equator out to radius ``extent``, ring by ring.
+    rim = prev
+    n_ring = len(rim)
+    phi = 2 * np.pi * np.arange(n_ring) / n_ring
+    all_v = [verts]
+    n0 = len(verts)
+    for r in np.linspace(radius, extent, max(2, int(np.ceil((extent - radius) / size)) + 1))[1:]:
+        all_v.append(center + np.stack([r * np.cos(phi), r * np.sin(phi), np.zeros(n_ring)], 1))
+        idx = list(range(n0, n0 + n_ring))
+        n0 += n_ring
+        faces = np.concatenate([faces, np.asarray(_stitch(rim, idx), np.int64)])
+        rim = idx
+    return np.concatenate(all_v), faces
+
+
+def _stitch(inner, outer):
+    """Triangles between two closed rings (counter-clockwise seen from +z on the cap)."""
+    tris = []
+    ni, no = len(inner), len(outer)
+    i = j = 0
+    while i < ni or j < no:
+        a_i, a_o = inner[i % ni], outer[j % no]
+        if ni == 1:
+            tris.append([a_i, a_o, outer[(j + 1) % no]])
+            j += 1
+            if j >= no:
+                break
+            continue
+        # advance along whichever ring is behind in angle
+        if j >= no or (i < ni and (i + 1) / ni < (j + 1) / no):
+            tris.append([a_i, a_o, inner[(i + 1) % ni]])
+            i += 1
+        else:
+            tris.append([a_i, a_o, outer[(j + 1) % no]])
+            j += 1
+    return tris
+
+
+__all__ = ["load_tool_mesh", "mesh_arrays", "grid_sdf_from_mesh", "signed_distance", "load_tool_sdf",
+           "hemisphere_rig_mesh"]

@@ -1,7 +1,9 @@
 """The wrinkle metric of the source paper (section 3.2, appendix B) as pure JAX functions.
 
 - :func:`tool_distance`: exact unsigned distance from fabric nodes to a tool surface (a triangle
-  mesh or an analytic tool such as :class:`HemisphereRig`).
+  mesh, its index from :func:`build_tool_index`, or tools of :mod:`jaxform.tools` such as
+  :func:`jaxform.tools.hemisphere_rig`; ``HemisphereRig`` and ``PlaneTool`` are the old names of
+  those tool constructors).
 - :func:`principal_curvatures`: nodal principal curvatures by iterative quadric fitting (B.1-B.9);
   :func:`kappa_max` (eq. 2).
 - :mod:`jaxform.metrics.wrinkles`: ``d_crit``, zones (wrinkle / bridging / conforming), wrinkle

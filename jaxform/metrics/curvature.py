@@ -22,8 +22,9 @@ normal side). A sphere with outward-pointing normals has ``k1 = k2 = +1/R``. ``k
 ``kappa_max = max(|k1|, |k2|)`` does not depend on the orientation.
 
 Design: the neighbour tables depend on the connectivity only, so they are built once on the host
-(numpy) as padded fixed-width tables with masks (:func:`curvature_stencil`, cached by the bytes of
-``faces``). The fit (:func:`curvatures_from_stencil`) is pure JAX with fixed shapes: jit-able,
+(numpy) as padded fixed-width tables with masks (:func:`curvature_stencil`): build the stencil at
+the edge and pass it (a pytree) to :func:`curvatures_from_stencil` for many frames;
+:func:`principal_curvatures` is the convenience that builds it on every call. The fit (:func:`curvatures_from_stencil`) is pure JAX with fixed shapes: jit-able,
 vmap-able over frames of node positions, differentiable with respect to the node positions (safe
 norms and divisions; the tiny ridge term keeps the 5x5 normal equations solvable for degenerate
 neighbourhoods, so every node, boundary nodes included, gets a finite value).
@@ -33,7 +34,6 @@ Under ``jit``/``vmap``, ``faces`` must be concrete (a numpy array, or a JAX arra
 """
 from __future__ import annotations
 
-import hashlib
 import warnings
 from typing import Any
 
@@ -42,6 +42,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
+from jaxform.geometry import safe_norm, safe_normalize, safe_sqrt
 
 __all__ = [
     "CurvatureStencil",
@@ -194,11 +195,8 @@ def _build_stencil(f: np.ndarray, n: int, rings: int = 1) -> CurvatureStencil:
     return CurvatureStencil(fan=fan, fan_mask=fan_mask, ring=ring, ring_mask=ring_mask, n_nodes=n)
 
 
-_STENCIL_CACHE: dict = {}
-
-
 def curvature_stencil(faces, n_nodes: int, *, rings: int = 1, check: bool = True) -> CurvatureStencil:
-    """Neighbour tables for :func:`curvatures_from_stencil` (host side, cached).
+    """Neighbour tables for :func:`curvatures_from_stencil` (host side; build once per mesh).
 
     Args:
       faces: (F, 3) triangles or (F, 4) quads, node indices (int32/int64, numpy or concrete JAX).
@@ -214,15 +212,7 @@ def curvature_stencil(faces, n_nodes: int, *, rings: int = 1, check: bool = True
         f = validate_faces(f, n_nodes)
     if rings not in (1, 2):
         raise ValueError(f"rings must be 1 or 2, got {rings!r}")
-    key = hashlib.blake2b(f.astype(np.int64).tobytes() + str((f.shape, n_nodes, rings)).encode(),
-                          digest_size=16).hexdigest()
-    st = _STENCIL_CACHE.get(key)
-    if st is None:
-        st = _build_stencil(f.astype(np.int64), int(n_nodes), int(rings))
-        if len(_STENCIL_CACHE) > 32:
-            _STENCIL_CACHE.pop(next(iter(_STENCIL_CACHE)))
-        _STENCIL_CACHE[key] = st
-    return st
+    return _build_stencil(f.astype(np.int64), int(n_nodes), int(rings))
 
 
 # ----------------------------------------------------------------------------------------------
@@ -232,18 +222,6 @@ def _dot(a, b):
     return jnp.sum(a * b, axis=-1)
 
 
-def _safe_norm(v, axis=-1, keepdims=False):
-    s = jnp.sum(v * v, axis=axis, keepdims=keepdims)
-    ok = s > 0.0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, s, 1.0)), 0.0)
-
-
-def _normalize(v, fallback):
-    n = _safe_norm(v, keepdims=True)
-    ok = n > 0.0
-    return jnp.where(ok, v / jnp.where(ok, n, 1.0), fallback)
-
-
 def _frame(n):
     """Orthonormal tangent vectors (e1, e2) for unit normals n (N,3): B.3-B.4."""
     dtype = n.dtype
@@ -251,8 +229,8 @@ def _frame(n):
     ey = jnp.array([0.0, 1.0, 0.0], dtype)
     use_y = jnp.abs(n[:, 0:1]) > 0.9  # normal (nearly) parallel to E1: project E2 instead
     base = jnp.where(use_y, ey, ex)
-    e1 = _normalize(base - _dot(base, n)[:, None] * n, jnp.broadcast_to(ey, n.shape))
-    e2 = _normalize(jnp.cross(n, e1), jnp.broadcast_to(ey, n.shape))
+    e1 = safe_normalize(base - _dot(base, n)[:, None] * n, jnp.broadcast_to(ey, n.shape))
+    e2 = safe_normalize(jnp.cross(n, e1), jnp.broadcast_to(ey, n.shape))
     return e1, e2
 
 
@@ -344,20 +322,20 @@ def curvatures_from_stencil(nodes, stencil: CurvatureStencil, *, max_iter: int =
     n0 = jnp.sum(jnp.where(ok[..., None], c, 0.0), axis=1)
 
     d = x[ring] - x[:, None, :]  # (N, W, 3)
-    dist = _safe_norm(d)
+    dist = safe_norm(d)
     cnt = jnp.maximum(jnp.sum(w, axis=1), 1.0)
     h = jnp.sum(dist * w, axis=1) / cnt
     h = jnp.where(h > 0.0, h, 1.0)
     # Fallback normal for a node whose fan cancels (should not happen on a valid mesh): +z.
     ez = jnp.broadcast_to(jnp.array([0.0, 0.0, 1.0], dtype), x.shape)
-    n = _normalize(n0, ez)
+    n = safe_normalize(n0, ez)
 
     def body(_, state):
         n, coef, done = state
         cf, e1, e2 = _fit(d, w, n, h)
         dd, ee = cf[:, 3], cf[:, 4]
-        n_new = _normalize(-dd[:, None] * e1 - ee[:, None] * e2 + n, n)  # B.8, R^T n_new
-        change = _safe_norm(n_new - n)
+        n_new = safe_normalize(-dd[:, None] * e1 - ee[:, None] * e2 + n, n)  # B.8, R^T n_new
+        change = safe_norm(n_new - n)
         coef = jnp.where(done[:, None], coef, cf)
         n = jnp.where(done[:, None], n, n_new)
         done = done | (change < tol)
@@ -372,8 +350,7 @@ def curvatures_from_stencil(nodes, stencil: CurvatureStencil, *, max_iter: int =
     # B.9 gives curvature positive towards the normal; SPEC: positive away from it.
     H = -H
     disc = H * H - K
-    okd = disc > 0.0
-    root = jnp.where(okd, jnp.sqrt(jnp.where(okd, disc, 1.0)), 0.0)
+    root = safe_sqrt(disc)
     return H + root, H - root
 
 

@@ -30,6 +30,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxform.geometry import quads_to_triangles, safe_norm, safe_sqrt
+
 __all__ = [
     "CONFORMING",
     "BRIDGING",
@@ -65,19 +67,6 @@ def d_crit(ply_thickness, ply_index: int = 1):
     return (ply_index - 0.5) * jnp.asarray(ply_thickness)
 
 
-def _tri_faces(faces):
-    f = jnp.asarray(faces)
-    if f.shape[1] == 4:
-        return jnp.concatenate([f[:, jnp.array([0, 1, 2])], f[:, jnp.array([0, 2, 3])]], axis=0)
-    return f
-
-
-def _safe_norm(v):
-    s = jnp.sum(v * v, axis=-1)
-    ok = s > 0.0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, s, 1.0)), 0.0)
-
-
 def node_areas(nodes, faces):
     """Lumped nodal areas: each face's area shared equally among its corners.
 
@@ -89,8 +78,8 @@ def node_areas(nodes, faces):
     x = jnp.asarray(nodes)
     f = jnp.asarray(faces)
     k = f.shape[1]
-    t = _tri_faces(f)
-    area_t = 0.5 * _safe_norm(jnp.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]))
+    t = quads_to_triangles(f)
+    area_t = 0.5 * safe_norm(jnp.cross(x[t[:, 1]] - x[t[:, 0]], x[t[:, 2]] - x[t[:, 0]]))
     if k == 4:
         n_f = f.shape[0]
         area_f = area_t[:n_f] + area_t[n_f:]
@@ -149,10 +138,10 @@ def wrinkle_radius(kappa_max, kappa_floor=1e-3):
 
 def _plane_basis(plane_normal, dtype):
     n = jnp.asarray(plane_normal, dtype)
-    n = n / _safe_norm(n)
+    n = n / safe_norm(n)
     ref = jnp.where(jnp.abs(n[0]) < 0.9, jnp.array([1.0, 0, 0], dtype), jnp.array([0, 1.0, 0], dtype))
     u = ref - jnp.dot(ref, n) * n
-    u = u / _safe_norm(u)
+    u = u / safe_norm(u)
     v = jnp.cross(n, u)
     # For the default normal +z this gives u = +x, v = +y: plane coordinates are (x, y).
     return u, v, n
@@ -183,7 +172,7 @@ def section_profile(nodes, faces, field, start, end, n_samples: int = 200,
     u, v, n = _plane_basis(plane_normal, dtype)
     p2 = jnp.stack([x @ u, x @ v], axis=1)
     hgt = x @ n
-    t = _tri_faces(faces)
+    t = quads_to_triangles(faces)
     a = jnp.asarray(start, dtype)
     b = jnp.asarray(end, dtype)
     s_frac = jnp.linspace(0.0, 1.0, n_samples, dtype=dtype)
@@ -210,7 +199,7 @@ def section_profile(nodes, faces, field, start, end, n_samples: int = 200,
     tj = t[j]
     val = L0 * fv[tj[:, 0]] + L1 * fv[tj[:, 1]] + L2 * fv[tj[:, 2]]
     height = L0 * hgt[tj[:, 0]] + L1 * hgt[tj[:, 1]] + L2 * hgt[tj[:, 2]]
-    length = _safe_norm(b - a)
+    length = safe_norm(b - a)
     return (s_frac * length, jnp.where(valid, val, 0.0), valid, jnp.where(valid, height, 0.0))
 
 
@@ -243,8 +232,7 @@ def section_nrmse(s_ref, ref, s_other, other, valid_ref=None, valid_other=None):
     mse = jnp.sum(w * (o - ref) ** 2) / n
     span = jnp.max(jnp.where(w > 0, ref, -jnp.inf)) - jnp.min(jnp.where(w > 0, ref, jnp.inf))
     span = jnp.where(jnp.isfinite(span) & (span > 0.0), span, 1.0)
-    ok = mse > 0.0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, mse, 1.0)), 0.0) / span
+    return safe_sqrt(mse) / span
 
 
 def count_section_wrinkles(values, valid=None, *, min_amplitude=0.0, min_prominence=0.5e-3):
@@ -344,9 +332,7 @@ def rms_fibre_moment(m1, m2):
     Returns:
       (E,) ``sqrt((m1^2 + m2^2) / 2)``, N; zero gradient at zero moment.
     """
-    s = 0.5 * (jnp.asarray(m1) ** 2 + jnp.asarray(m2) ** 2)
-    ok = s > 0.0
-    return jnp.where(ok, jnp.sqrt(jnp.where(ok, s, 1.0)), 0.0)
+    return safe_sqrt(0.5 * (jnp.asarray(m1) ** 2 + jnp.asarray(m2) ** 2))
 
 
 def probability_density(values, bins: int = 50, value_range=None, weights=None):

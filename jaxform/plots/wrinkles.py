@@ -5,12 +5,13 @@ import pathlib
 
 import numpy as np
 
+from jaxform.geometry import quads_to_triangles
+
 __all__ = ["plot_node_field", "plot_zones", "plot_density"]
 
 
-def _triangles(faces: np.ndarray) -> np.ndarray:
-    f = np.asarray(faces)
-    return np.concatenate([f[:, [0, 1, 2]], f[:, [0, 2, 3]]]) if f.shape[1] == 4 else f
+def _triangles(faces) -> np.ndarray:
+    return np.asarray(quads_to_triangles(faces))
 
 
 def _figure():

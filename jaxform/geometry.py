@@ -162,20 +162,16 @@ def _weights(p, a, b, c):
     w = pick((d3 >= 0) & (d4 <= d3), (zero, one, zero), w)  # vertex b
     w = pick((d1 <= 0) & (d2 <= 0), (one, zero, zero), w)  # vertex a
     # Zero-area triangle (den = |ab x ac|^2 ~ 0): the regions above are ill-posed; the closest
-    # point is the nearest of the three edge projections.
-    ab2, ac2 = d1 - d3, d2 - d6
+    # point is the nearest of the three edge projections, |e0 p - t e|^2 = |e0 p|^2 - 2 t (e.e0p)
+    # + t^2 |e|^2 from the dot products above (bc.bp = d4 - d3).
+    ab2, ac2, bc2 = d1 - d3, d2 - d6, (d4 - d3) + (d5 - d6)
     degenerate = den <= 1e-24 * (ab2 + ac2) * (ab2 + ac2)
-    e_ab = (1.0 - t_ab, t_ab, zero)
-    e_ac = (1.0 - t_ac, zero, t_ac)
-    e_bc = (zero, 1.0 - t_bc, t_bc)
-
-    def sq(wt):
-        r = tuple(p[i] - (wt[0] * a[i] + wt[1] * b[i] + wt[2] * c[i]) for i in range(3))
-        return _dot(r, r)
-
-    s_ab, s_ac, s_bc = sq(e_ab), sq(e_ac), sq(e_bc)
-    seg = pick(s_ac < s_ab, e_ac, e_ab)
-    seg = pick(s_bc < jnp.minimum(s_ab, s_ac), e_bc, seg)
+    ap2, bp2 = _dot(ap, ap), _dot(bp, bp)
+    s_ab = ap2 - t_ab * (2.0 * d1 - t_ab * ab2)
+    s_ac = ap2 - t_ac * (2.0 * d2 - t_ac * ac2)
+    s_bc = bp2 - t_bc * (2.0 * (d4 - d3) - t_bc * bc2)
+    seg = pick(s_ac < s_ab, (1.0 - t_ac, zero, t_ac), (1.0 - t_ab, t_ab, zero))
+    seg = pick(s_bc < jnp.minimum(s_ab, s_ac), (zero, 1.0 - t_bc, t_bc), seg)
     return pick(degenerate, seg, w)
 
 

@@ -16,6 +16,9 @@ params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm`` (= b_inf + 
 measured x), ``sigma_*`` (Gauss–Newton standard errors), ``kappa_max_over_kappa0`` and
 ``b_inf_determined``, ``iterations``, ``wall_time_s``. An existing --out is never overwritten
 without --force.
+
+Progress goes to stderr, one update per optimiser iteration: a tqdm bar on a terminal, plain
+lines (at most one every ``--progress-every`` seconds, and the last) when stderr is a file or pipe.
 """
 from __future__ import annotations
 
@@ -24,6 +27,34 @@ import importlib
 import pathlib
 import sys
 import time
+
+
+class _Progress:
+    """Per-iteration progress of one fit on stderr: tqdm on a terminal, plain periodic lines otherwise."""
+
+    def __init__(self, label: str, total: int, every_s: float):
+        self.label, self.every_s, self.last = label, every_s, -float("inf")
+        self.bar = None
+        if sys.stderr.isatty():
+            from tqdm import tqdm
+
+            self.bar = tqdm(total=total, desc=f"fit [{label}]", unit="it", file=sys.stderr, leave=True)
+
+    def __call__(self, info) -> None:
+        text = f"rmse {1e3 * info.rmse:.4f} mm, B_init {float(info.law.b_init):.4g} N·m, {info.n_evaluations} evaluations"
+        if self.bar is not None:
+            self.bar.update(info.iteration - self.bar.n)
+            self.bar.set_postfix_str(text)
+        elif time.monotonic() - self.last >= self.every_s:
+            self.last = time.monotonic()
+            print(f"fit [{self.label}] iteration {info.iteration}: {text}", file=sys.stderr, flush=True)
+
+    def close(self, fit) -> None:
+        if self.bar is not None:
+            self.bar.close()
+        else:
+            print(f"fit [{self.label}] done: {fit.iterations} iterations, {fit.n_simulations} simulations, "
+                  f"rmse {1e3 * fit.rmse:.4f} mm", file=sys.stderr, flush=True)
 
 
 def _simulate_from_spec(spec: str):
@@ -45,6 +76,9 @@ def main(argv=None) -> int:
     ap.add_argument("--simulate", default="jaxform.cantilever:simulate",
                     help="forward model MODULE:FUNCTION (default jaxform.cantilever:simulate)")
     ap.add_argument("--float32", action="store_true", help="run in float32 (default float64)")
+    ap.add_argument("--max-iter", type=int, default=60, help="largest number of optimiser evaluations")
+    ap.add_argument("--progress-every", type=float, default=10.0, metavar="S",
+                    help="seconds between progress lines when stderr is not a terminal (default 10)")
     args = ap.parse_args(argv)
 
     if len(args.profile) != len(args.overhang_mm):
@@ -83,8 +117,11 @@ def main(argv=None) -> int:
     t0 = time.perf_counter()
     results, fits = {}, {}
     for side, profs in groups.items():
+        progress = _Progress(side, args.max_iter, args.progress_every)
         fit = calibrate.fit_cantilever(profs, areal_mass=areal_mass, law=args.law, simulate=simulate,
-                                       compute_b41_5=not args.no_standard_test)
+                                       compute_b41_5=not args.no_standard_test, max_iter=args.max_iter,
+                                       callback=progress)
+        progress.close(fit)
         fits[side] = fit
         d = fit.as_dict()
         d.update(side=side, areal_mass_gsm=args.areal_mass_gsm,

@@ -2,8 +2,9 @@
 
 Both rigs use the SAME shell kernel as forming (:mod:`jaxform.shell`): its energy, with forces
 and stiffness taken by ``jax.grad`` / ``jax.hessian``. They are quasi-static: the driven nodes are
-prescribed, the free in-plane dofs are brought to equilibrium by Newton's method on the shell
-energy (dense Hessian, small meshes), and reaction forces are ``grad E`` at the driven nodes.
+prescribed, the free in-plane dofs are brought to equilibrium by the damped Newton solver of
+:mod:`jaxform.statics` (the one the cantilever uses; dense Hessian, small meshes), and reaction
+forces are ``grad E`` at the driven nodes.
 Out-of-plane dofs stay at ``z = 0`` (the flat state is an equilibrium; wrinkling is not studied).
 
 Picture frame (:func:`picture_frame`)
@@ -24,7 +25,7 @@ Picture frame (:func:`picture_frame`)
     * ``f_norm`` (N/m): the ``F_norm`` the shell's reading implies from the measured response:
       ``resultant`` itself for ``shear_reading="conjugate"`` (``dW/dgamma = F_norm``), its
       derivative ``d resultant/dgamma`` for ``"a14"`` (``dW/dgamma = int_0^gamma F_norm``; the
-      derivative is the exact tangent of the equilibrium path, by implicit differentiation);
+      derivative is the exact tangent of the equilibrium path, by :func:`jaxform.statics.implicit`);
     * ``f_norm_classical = F / (2 L cos(phi))`` (N/m), the experimentalists' normalisation (force
       per unit frame length, power-conjugate to ``gamma`` per unit *current* area);
       ``f_norm_classical = resultant / cos(gamma)``.
@@ -34,12 +35,13 @@ Bias extension (:func:`bias_extension`)
     (all nodes of each end prescribed, one end moved by ``d`` along the axis). The mesh is the
     fibre lattice (nodes ``(i a, j a)`` with ``i + j`` even), each lattice cell split along its
     axial diagonal, so every triangle has two fibre-aligned edges and the pin-jointed net is
-    representable without locking. Extension is applied in increments, each solved by Newton.
+    representable without locking. Extension is applied in increments, each solved to rest.
     The central zone's shear angle is the area-weighted mean over the triangles whose reference
     centroid lies in the inner half of zone A (``|x - H/2| + |y - W/2| < W/4``).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 from typing import Any
 
@@ -47,6 +49,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxform import statics
 from jaxform._pytree import pytree_dataclass
 from jaxform.mesh import Mesh
 from jaxform.shell import Shell, energy, shear_angle, fibre_vectors
@@ -69,69 +72,54 @@ def _energy2(xy, shell: Shell):
     return energy(x, shell)
 
 
+@pytree_dataclass
+class _InPlane:
+    """The flat rig as a :mod:`jaxform.statics` problem: the free in-plane dofs of ``xy``.
+
+    Attributes:
+        shell: the specimen's shell.
+        xy: (2N,) in-plane node positions, m, the driven ones prescribed (the free ones are the unknowns).
+        free_idx: (n,) int indices of the free dofs in ``xy``.
+    """
+
+    shell: Any
+    xy: Any
+    free_idx: Any
+
+    def full(self, u):
+        """(2N,) positions with the free dofs ``u``."""
+        return self.xy.at[self.free_idx].set(u)
+
+    def energy(self, u, load):
+        return _energy2(self.full(u), self.shell)
+
+    def hessian(self, u, load):
+        return statics.dense_hessian(self, u, load)
+
+    def lift(self, du):
+        return du
+
+
+_reactions = jax.jit(jax.grad(_energy2))  # (2N,) out-of-balance forces grad E, N
+_NO_LOAD = jnp.zeros((1, 1))  # the flat rigs have no load path: each state is solved on its own
+
+
 @jax.jit
-def _egh(xy, shell):
-    return _energy2(xy, shell), jax.grad(_energy2)(xy, shell), jax.hessian(_energy2)(xy, shell)
+def _grad_norm(problem, u):
+    return jnp.linalg.norm(jax.grad(problem.energy)(u, _NO_LOAD[0]))
 
 
-_energy_jit = jax.jit(_energy2)
+def _equilibrium(shell: Shell, xy, free, *, tol=1e-10, max_iter=60):
+    """Free dofs (bool mask over the flat (2N,) vector) brought to rest from ``xy`` by
+    :func:`jaxform.statics.solve`, to ``|grad E| <= tol max(|grad E(xy)|, 1 N)``.
 
-
-@jax.jit
-def _newton_direction(H, g, shift):
-    # linear algebra inside XLA: host BLAS threads are slow on a loaded machine
-    H = H + shift * jnp.eye(H.shape[0], dtype=H.dtype)
-    c = jnp.linalg.cholesky(H)
-    y = jax.scipy.linalg.solve_triangular(c, -g, lower=True)
-    return jax.scipy.linalg.solve_triangular(c.T, y, lower=False)
-
-
-@jax.jit
-def _solve(A, b):
-    return jnp.linalg.solve(A, b)
-
-
-class _Statics:
-    """Energy, gradient and Hessian of the in-plane problem (compiled once per mesh size and law type)."""
-
-    def __init__(self, shell: Shell):
-        self.shell = shell
-
-    def energy(self, xy):
-        return _energy_jit(xy, self.shell)
-
-    def egh(self, xy):
-        return _egh(jnp.asarray(xy), self.shell)
-
-    def solve(self, xy, free, *, tol=1e-10, max_iter=60):
-        """Newton on the free dofs (bool mask over the flat (2N,) vector) with backtracking; returns xy."""
-        xy = jnp.asarray(np.array(xy, np.float64))
-        idx = jnp.asarray(np.nonzero(free)[0])
-        if idx.size == 0:
-            return np.asarray(xy)
-        g0 = None
-        for _ in range(max_iter):
-            e0, g, H = self.egh(xy)
-            g, H = g[idx], H[idx][:, idx]
-            gn = float(jnp.linalg.norm(g))
-            g0 = gn if g0 is None else g0
-            if gn <= tol * max(g0, 1.0) or gn < 1e-13:
-                break
-            shift = 0.0
-            dx = _newton_direction(H, g, shift)
-            while not bool(jnp.all(jnp.isfinite(dx))):  # not positive definite: shift (Levenberg)
-                shift = 1e-10 * float(jnp.max(jnp.abs(jnp.diag(H)))) if shift == 0.0 else 100.0 * shift
-                dx = _newton_direction(H, g, shift)
-            e0 = float(e0)
-            slope = float(g @ dx)
-            t = 1.0
-            for _ in range(30):
-                trial = xy.at[idx].add(t * dx)
-                if float(self.energy(trial)) <= e0 + 1e-4 * t * slope + 1e-15 * abs(e0):
-                    break
-                t *= 0.5
-            xy = trial
-        return np.asarray(xy)
+    Returns ``(problem, equilibrium)``; ``problem.full(equilibrium.u)`` is the (2N,) solution.
+    """
+    problem = _InPlane(shell, jnp.asarray(np.asarray(xy, np.float64)), jnp.asarray(np.nonzero(free)[0]))
+    u0 = problem.xy[problem.free_idx]
+    atol = tol * max(float(_grad_norm(problem, u0)), 1.0)
+    eq = statics.solve(problem, u0, _NO_LOAD.astype(u0.dtype), jnp.asarray([atol], u0.dtype), max_iter, jnp.inf, 0.0)
+    return problem, eq
 
 
 # ------------------------------------------------------------------------------------ picture frame
@@ -171,6 +159,29 @@ def picture_frame_displacement(gamma, side):
     return 2.0 * side * np.cos(0.25 * np.pi - 0.5 * np.asarray(gamma, float)) - math.sqrt(2.0) * side
 
 
+def _frame_xy(X, g):
+    """(2N,) positions ``x = F(g) X`` of the frame's kinematics, ``F e_1 = (cos g/2, sin g/2)``,
+    ``F e_2 = (sin g/2, cos g/2)``; ``X`` (N, 2) reference positions, m, ``g`` the shear angle, rad."""
+    c, s = jnp.cos(0.5 * g), jnp.sin(0.5 * g)
+    return (X @ jnp.stack([jnp.stack([c, s]), jnp.stack([s, c])]).T).ravel()
+
+
+@jax.jit
+def _frame_work(problem, X, driven, u_star, hessian, g):
+    """Virtual work of the reactions on the driven nodes per unit ``gamma`` (``F dd/dgamma``, N·m),
+    its derivative along the equilibrium path (the free nodes follow by the implicit function
+    theorem, :func:`jaxform.statics.implicit`), and the (2N,) out-of-balance forces ``grad E``, N."""
+
+    def work(gam):
+        p = dataclasses.replace(problem, xy=_frame_xy(X, gam))
+        R = jax.grad(_energy2)(p.full(statics.implicit(p, u_star, hessian, _NO_LOAD[0])), p.shell)
+        v = jax.jvp(lambda t: _frame_xy(X, t), (gam,), (jnp.ones_like(gam),))[1]  # dx/dgamma
+        return R[driven] @ v[driven], R
+
+    (w, R), (dw, _) = jax.jvp(work, (g,), (jnp.ones_like(g),))
+    return w, dw, R
+
+
 def picture_frame(fabric_or_law, *, side: float = 0.1, gamma_max: float = math.radians(60.0), n: int = 6,
                   n_points: int = 13, gamma_min: float | None = None, shear_reading: str = "a14") -> PictureFrameResult:
     """Quasi-static picture frame on the shell (module docstring).
@@ -181,7 +192,7 @@ def picture_frame(fabric_or_law, *, side: float = 0.1, gamma_max: float = math.r
             (then a 1 mm, 3 GPa fabric).
         side: frame side ``L`` pin to pin, m.
         gamma_max: largest shear angle, rad (< pi/2).
-        n: elements per side (n x n quads, 2 n^2 triangles).
+        n: elements per side (n x n quads, 2 n^2 triangles; >= 2, so that there are interior nodes).
         n_points: load points, equally spaced in ``gamma`` from ``gamma_min`` (default
             ``gamma_max / n_points``) to ``gamma_max``.
         shear_reading: the shell's reading of ``F_norm`` (``"a14"`` or ``"conjugate"``).
@@ -190,48 +201,30 @@ def picture_frame(fabric_or_law, *, side: float = 0.1, gamma_max: float = math.r
         raise ValueError(f"picture_frame: gamma_max = {gamma_max!r} rad: must lie in (0, pi/2)")
     if not side > 0:
         raise ValueError(f"picture_frame: side = {side!r}: must be a positive length in m")
+    if int(n) < 2:
+        raise ValueError(f"picture_frame: n = {n!r}: must be >= 2 elements per side (the interior is solved for)")
     fab = _as_fabric(fabric_or_law, (0.0, 0.5 * math.pi))
     mesh = Mesh.rectangle(side, side, side / n)
     shell = Shell.build(mesh, fab, shear_reading=shear_reading)
-    st = _Statics(shell)
     X = np.asarray(mesh.nodes)[:, :2]
     N = len(X)
     tol = 1e-9 * side
     bnd = (X[:, 0] < tol) | (X[:, 0] > side - tol) | (X[:, 1] < tol) | (X[:, 1] > side - tol)
     free = np.repeat(~bnd, 2)
-    fidx = np.nonzero(free)[0]
-    didx = np.nonzero(~free)[0]
-
-    def fmat(g, order):
-        c, s = math.cos(0.5 * g), math.sin(0.5 * g)
-        if order == 0:
-            return np.array([[c, s], [s, c]])
-        if order == 1:
-            return 0.5 * np.array([[-s, c], [c, -s]])
-        return 0.25 * np.array([[-c, -s], [-s, -c]])
-
+    driven = jnp.asarray(np.nonzero(~free)[0])
     g0 = gamma_max / n_points if gamma_min is None else gamma_min
     gammas = np.linspace(g0, gamma_max, n_points)
     out = {k: [] for k in ("force", "resultant", "dres", "gmesh", "res")}
     for g in gammas:
-        xy = (X @ fmat(g, 0).T).ravel()
-        xy = st.solve(xy, free)
-        _, R, H = st.egh(xy)
-        R, H = np.asarray(R), np.asarray(H)
-        v = (X @ fmat(g, 1).T).ravel()  # dx/dgamma of the driven nodes
-        a = (X @ fmat(g, 2).T).ravel()
+        problem, eq = _equilibrium(shell, _frame_xy(jnp.asarray(X), g), free)
+        work, dwork, R = _frame_work(problem, jnp.asarray(X), driven, eq.u, eq.hessian, jnp.asarray(g))
         dd = side * math.sin(0.25 * math.pi - 0.5 * g)
-        work = float(R[didx] @ v[didx])
-        # tangent of the reaction along the equilibrium path: H_ff dxf = -H_fd v_d
-        dxf = -np.asarray(_solve(H[np.ix_(fidx, fidx)], H[np.ix_(fidx, didx)] @ v[didx])) if fidx.size else np.zeros(0)
-        dR = H[:, didx] @ v[didx] + (H[:, fidx] @ dxf if fidx.size else 0.0)
-        dwork = float(dR[didx] @ v[didx] + R[didx] @ a[didx])
-        out["force"].append(work / dd)
-        out["resultant"].append(work / side**2)
-        out["dres"].append(dwork / side**2)
-        x3 = jnp.concatenate([jnp.asarray(xy).reshape(N, 2), jnp.zeros((N, 1))], axis=1)
+        out["force"].append(float(work) / dd)
+        out["resultant"].append(float(work) / side**2)
+        out["dres"].append(float(dwork) / side**2)
+        x3 = jnp.concatenate([problem.full(eq.u).reshape(N, 2), jnp.zeros((N, 1))], axis=1)
         out["gmesh"].append(float(jnp.mean(shear_angle(fibre_vectors(x3, mesh, shell.ref), shell.ref))))
-        out["res"].append(float(np.abs(R[fidx]).max()) if fidx.size else 0.0)
+        out["res"].append(float(jnp.max(jnp.abs(R[problem.free_idx]))))
     force = np.asarray(out["force"])
     resultant = np.asarray(out["resultant"])
     f_norm = resultant if shear_reading == "conjugate" else np.asarray(out["dres"])
@@ -321,7 +314,6 @@ def bias_extension(fabric_or_law, *, width: float = 0.05, length: float | None =
     fab = _as_fabric(fabric_or_law, (0.25 * math.pi, -0.25 * math.pi))
     mesh = bias_mesh(width, length, cells_across)
     shell = Shell.build(mesh, fab, shear_reading=shear_reading)
-    st = _Statics(shell)
     X = np.asarray(mesh.nodes)[:, :2]
     N = len(X)
     tol = 1e-9 * length
@@ -340,8 +332,9 @@ def bias_extension(fabric_or_law, *, width: float = 0.05, length: float | None =
         guess = xy + (xy - prev) if k > 1 else xy.copy()  # linear predictor
         guess[rx] = X[right, 0] + d
         prev = xy
-        xy = st.solve(guess, free, tol=1e-11, max_iter=100)
-        R = np.asarray(st.egh(xy)[1])
+        problem, eq = _equilibrium(shell, guess, free, tol=1e-11, max_iter=100)
+        xy = np.asarray(problem.full(eq.u))
+        R = np.asarray(_reactions(xy, shell))
         x3 = jnp.concatenate([jnp.asarray(xy).reshape(N, 2), jnp.zeros((N, 1))], axis=1)
         g = np.asarray(shear_angle(fibre_vectors(x3, mesh, shell.ref), shell.ref))
         res["d"].append(d)

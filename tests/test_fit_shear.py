@@ -77,16 +77,6 @@ def test_toml_round_trip(tmp_path):
         cf.write_shear_toml(path, fit.as_dict())
 
 
-def test_check_needs_the_frame_rig_or_runs():
-    g = np.linspace(0.01, 0.8, 40)
-    fit = C.fit_shear_polynomial(g, 50 * g, degree=1)
-    try:
-        import jaxform.frame_tests  # noqa: F401
-    except ImportError:
-        with pytest.raises(NotImplementedError, match="frame_tests"):
-            C.check_shear_fit(fit)
-
-
 def test_fit_shear_command_raw_frame_data(tmp_path):
     L = 0.145
     gamma = np.radians(np.linspace(1, 55, 40))

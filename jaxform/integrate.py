@@ -289,23 +289,33 @@ _CAUSES = {
 }
 
 
-def check(state: State, frames: Frames, model: Model):
-    """Host: raise :class:`SimulationError` if the run failed (frames up to the last good one kept)."""
+def failure_cause(state: State) -> str | None:
+    """Host: the cause recorded at ``state.bad_step`` in words (None if healthy)."""
+    return None if int(state.bad_step) < 0 else _CAUSES.get(int(state.bad_code), "unknown")
+
+
+def describe_failure(state: State, model: Model) -> str:
+    """Host: what failed at ``state.bad_step`` and the likely cause, in words (empty if healthy)."""
     bad = int(state.bad_step)
     if bad < 0:
-        return
-    code = int(state.bad_code)
+        return ""
     dt = float(model.dt)
+    return (f"simulation failed at step {bad} (t = {bad * dt:.6e} s): {failure_cause(state)}. "
+            f"Likely cause: the time step {dt:.3e} s is too large for the mesh (stable estimate "
+            f"{stable_time_step(model.shell, model.mass_scale, safety=1.0):.3e} s), or a distorted/inverted "
+            "element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh.")
+
+
+def check(state: State, frames: Frames, model: Model):
+    """Host: raise :class:`SimulationError` if the run failed (frames up to the last good one kept)."""
+    if int(state.bad_step) < 0:
+        return
+    bad = int(state.bad_step)
     ok = np.asarray(frames.ok)
     good = jax.tree_util.tree_map(lambda a: a[: int(ok.sum())], frames)
-    raise SimulationError(
-        f"simulation failed at step {bad} (t = {bad * dt:.6e} s): {_CAUSES.get(code, 'unknown')}. "
-        f"Likely cause: the time step {dt:.3e} s is too large for the mesh (stable estimate "
-        f"{stable_time_step(model.shell, model.mass_scale, safety=1.0):.3e} s), or a distorted/inverted "
-        "element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh. "
-        f"{int(ok.sum())} good frames are in .frames.",
-        step=bad, time=bad * dt, cause=_CAUSES.get(code), frames=good, state=state,
-    )
+    raise SimulationError(f"{describe_failure(state, model)} {int(ok.sum())} good frames are in .frames.",
+                          step=bad, time=bad * float(model.dt), cause=failure_cause(state), frames=good,
+                          state=state)
 
 
 def simulate(model: Model, state: State | None = None, *, n_frames: int, every: int, checkpoint: bool = True,
@@ -318,4 +328,4 @@ def simulate(model: Model, state: State | None = None, *, n_frames: int, every: 
     return s, frames
 
 
-__all__ = ["make_model", "init_state", "step", "run_steps", "rollout", "simulate", "check", "Frames", "SimulationError"]
+__all__ = ["make_model", "init_state", "step", "run_steps", "rollout", "simulate", "check", "failure_cause", "describe_failure", "Frames", "SimulationError"]

@@ -135,3 +135,24 @@ def test_overrides_are_named_in_the_description():
     c = cases.with_element_size(cases.load("case-a-woven-nlbm"), 4e-3)
     assert "2 mm elements" in c.description and "blank.element_size_mm=4.0" in c.description
     assert cases.apply_overrides(c, ['description="my run"']).description == "my run"
+
+
+@pytest.mark.parametrize("override, key, words", [
+    ("tools.holder_opening_radius_mm=40", "tools.holder_opening_radius_mm", "holder opening"),
+    ("fabric.shear_poly_N_per_m=[-37.35, 322.61]", "fabric.shear_poly_N_per_m", "initial shear stiffness"),
+    ("fabric.shear_poly_N_per_m=[10.0, -100.0]", "fabric.shear_poly_N_per_m", "must be positive"),
+    ("contact.damping_ratio=30", "contact.damping_ratio", "critical damping"),
+])
+def test_physically_impossible_setups_are_refused_with_the_allowed_range(override, key, words):
+    with pytest.raises(ValueError, match=key.replace(".", r"\.")) as err:
+        cases.apply_overrides(cases.load("case-a-woven-nlbm"), [override])
+    assert words in str(err.value)
+
+
+def test_contact_damping_bound_follows_the_explicit_stability_limit():
+    case = cases.load("case-a-woven-nlbm")
+    # omega dt = sqrt(safety): stable while zeta <= (4 - safety) / (4 sqrt(safety)), 0.782 at 0.95
+    cases.apply_overrides(case, ["contact.safety=0.95", "contact.damping_ratio=0.78"])
+    with pytest.raises(ValueError, match="stable only up to 0.782"):
+        cases.apply_overrides(case, ["contact.safety=0.95", "contact.damping_ratio=0.79"])
+    cases.apply_overrides(case, ["contact.damping_ratio=1.0"])

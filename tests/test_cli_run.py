@@ -9,8 +9,8 @@ import pytest
 from jaxform.cli import main
 
 FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]
-FIELDS = ("displacement", "shear_angle_deg", "fibre_strain", "bending_moment", "M_f_rms", "contact_pressure",
-          "deviation", "ply_id")
+FIELDS = ("displacement_m", "shear_angle_deg", "fibre_strain", "bending_moment_N", "M_f_rms_N", "contact_pressure_Pa",
+          "deviation_m", "ply_id")
 
 
 def _pvd_files(out):
@@ -40,13 +40,14 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert m.points.shape == (121, 3) and m.cells[0].type == "quad"
     # points at their deformed positions: the centre went down with the punch
     assert m.points[:, 2].min() == pytest.approx(0.15e-3 - 4e-3, abs=0.2e-3)
-    np.testing.assert_allclose(m.point_data["displacement"], m.points - meshio.read(tmp_out / frames[0][1]).points,
+    np.testing.assert_allclose(m.point_data["displacement_m"], m.points - meshio.read(tmp_out / frames[0][1]).points,
                                atol=1e-6)
     for png in ("shear_angle.png", "deviation.png", "punch_force.png"):
         assert (tmp_out / png).read_bytes()[:4] == b"\x89PNG"
-    # a second run may replace its own output
+    # a second run replaces its own output completely: no stale frames beside the new .pvd
     assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--set", "process.frames=2"]) == 0
     assert len(_pvd_files(tmp_out)) == 2
+    assert sorted(p.name for p in tmp_out.glob("frames_*.vtu")) == ["frames_00000.vtu", "frames_00001.vtu"]
 
 
 def test_a_run_normalises_its_case_and_builds_its_rig_once(tmp_out, monkeypatch):
@@ -135,3 +136,66 @@ def test_run_from_a_case_file(tmp_path, capsys):
                  "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["case"] == "my-run" and s["complete"] is True
+
+
+def test_sigterm_stops_a_run_like_ctrl_c(tmp_out, monkeypatch):
+    import os
+    import signal
+
+    from jaxform.cli import run as run_mod
+
+    original = run_mod.Progress.__call__
+
+    def terminate(self, step, n_steps, *a):
+        if step > n_steps * 0.6:
+            os.kill(os.getpid(), signal.SIGTERM)
+        return original(self, step, n_steps, *a)
+
+    monkeypatch.setattr(run_mod.Progress, "__call__", terminate)
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 143
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False and s["reason"] == "terminated by SIGTERM"
+    assert s["frames_written"] == len(_pvd_files(tmp_out)) == 2
+
+
+def test_a_run_that_leaves_its_physical_bounds_stops_and_says_why(tmp_out):
+    import dataclasses
+
+    from jaxform import cases, forming
+    from jaxform.cli.run import OUTPUTS, point_data
+    from jaxform.io.frames import FrameWriter
+    from jaxform.io.output import prepare_output_dir
+
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["process.stroke_mm=4", "process.frames=3"])
+    model, state, info = forming.build(case)
+    # the punch moves the centre at the punch speed: a bound below it is crossed in the first chunk
+    tight = dataclasses.replace(info.bounds, speed=0.5 * case.process.speed)
+    writer = FrameWriter(prepare_output_dir(tmp_out, replaces=OUTPUTS), info.faces)
+    result = forming.run((model, state, dataclasses.replace(info, bounds=tight)), catch=True,
+                         on_frame=lambda k, t, x, f: writer.write(t, x, point_data(f, info.ply_id)))
+    assert not result.complete and "physical bounds" in result.reason and "m/s" in result.reason
+    assert result.summary["complete"] is False and len(result.t) == 1
+    assert len(_pvd_files(tmp_out)) == 1
+
+
+def test_a_run_blown_up_by_an_impossible_contact_damping_is_refused_at_the_edge(tmp_out, capsys):
+    args = ["run", "case-a-woven-nlbm", "--out", str(tmp_out), "--element-size-mm", "20", "--set",
+            "process.stroke_mm=10", "--set", "contact.damping_ratio=30"]
+    assert main(args) == 2
+    assert "contact.damping_ratio" in capsys.readouterr().err and not tmp_out.exists()
+
+
+@pytest.mark.slow
+def test_a_blown_up_run_is_not_reported_complete(tmp_out):
+    """Issue 14 item 1 as it was found: damping ratio 30 (refused at the edge now, forced here)."""
+    import dataclasses
+
+    from jaxform import cases
+    from jaxform.cli.run import execute
+
+    case = cases.resolve("case-a-woven-nlbm", element_size=20e-3, overrides=["process.stroke_mm=10"])
+    case = dataclasses.replace(case, contact=dataclasses.replace(case.contact, damping_ratio=30.0))
+    result, _ = execute(case, tmp_out, quiet=True)
+    assert not result.complete and "failed" in result.reason
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False

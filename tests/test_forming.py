@@ -56,9 +56,9 @@ def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N(fabric):
     r = forming.simulate(case, samples_per_frame=12)
     assert r.complete, r.reason
     h = case.ply_thickness
-    t = r.history["t"]
+    t = r.history["t_s"]
     seated = t > 0.5 * t[-1]
-    np.testing.assert_allclose(r.history["holder_force"][seated], 1000.0, rtol=0.02)
+    np.testing.assert_allclose(r.history["holder_force_N"][seated], 1000.0, rtol=0.02)
     # ply 1 on ply 2: no interpenetration beyond 10% of the thickness; under the holder they touch
     model, s = r.model, r.final_state
     pl = model.loads[3]

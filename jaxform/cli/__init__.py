@@ -7,7 +7,9 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import signal
 import sys
+import threading
 
 # Sub-command modules, in the order ``jaxform --help`` lists them.
 _COMMANDS = ("demo", "cases", "run", "wrinkles")
@@ -33,17 +35,33 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+TERMINATED = "terminated by SIGTERM"
+"""The reason a run stopped by ``kill`` or a scheduler records (the command exits 143)."""
+
+
+def _terminate(signum, frame):
+    raise KeyboardInterrupt(TERMINATED)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     if args.command is None:
         parser.print_help()
         return 2
+    # SIGTERM (kill, a scheduler) stops a run like Ctrl-C does: what was written stays valid and says why
+    previous = signal.signal(signal.SIGTERM, _terminate) if threading.current_thread() is threading.main_thread() else None
     try:
         return int(args.handler(args) or 0)
     except (ValueError, FileNotFoundError, FileExistsError) as err:
         print(f"jaxform {args.command}: error: {err}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt as err:
+        print(f"jaxform {args.command}: {err or 'interrupted'}", file=sys.stderr)
+        return 143 if str(err) == TERMINATED else 130
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
 
 
 if __name__ == "__main__":

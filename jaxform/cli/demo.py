@@ -100,6 +100,6 @@ def run(args) -> int:
                             element_size=size * 1e-3, overrides=getattr(args, "overrides", []), owner="demo")
     report(result, files, forming_out)
     print(f"Open {forming_out.resolve() / 'frames.pvd'} in ParaView (File > Open, Apply, then colour by "
-          "shear_angle_deg or deviation and press Play); the PNGs open in any image viewer; "
+          "shear_angle_deg or deviation_m and press Play); the PNGs open in any image viewer; "
           "summary.json holds the energies, punch force and draw-in.")
     return 0 if result.complete else 1

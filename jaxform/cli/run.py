@@ -1,8 +1,8 @@
 """``jaxform run NAME|CASE.toml --out DIR``: a hemisphere forming run with frames, summary and plots.
 
-Writes into DIR: ``frames.pvd`` with ``frames_#####.vtu`` (deformed positions; point fields
-displacement, shear angle, fibre strain and bending moment per family, M_f^RMS, contact pressure,
-deviation from the tools, ply id), ``summary.json`` (SPEC section 6 keys, inputs, energy and
+Writes into DIR: ``frames.pvd`` with ``frames_#####.vtu`` (deformed positions in m; point fields
+named with their unit, :data:`FIELD_UNITS`: displacement, shear angle, fibre strain and bending
+moment per family, M_f^RMS, contact pressure, deviation from the tools, ply id), ``summary.json`` (SPEC section 6 keys, inputs, energy and
 force histories, draw-in, versions) and PNG plots. The summary is written at the start with
 ``complete: false`` and rewritten at the end; an interrupted (Ctrl-C) or failed run keeps the frames
 written so far and says why in ``reason``.
@@ -16,9 +16,17 @@ import time
 from jaxform.cli.progress import Progress
 
 FIELD_UNITS = {
-    "displacement": "m", "shear_angle_deg": "degree", "fibre_strain": "-", "bending_moment": "N (N·m/m)",
-    "M_f_rms": "N", "contact_pressure": "Pa", "deviation": "m", "ply_id": "-",
+    "displacement_m": "m", "shear_angle_deg": "degree", "fibre_strain": "dimensionless (|g_f| - 1)",
+    "bending_moment_N": "N (N·m/m)", "M_f_rms_N": "N", "contact_pressure_Pa": "Pa", "deviation_m": "m",
+    "ply_id": "-",
 }
+"""The VTU point fields of a frame: each name ends with its unit (as in ``wrinkles.vtu``)."""
+
+
+QUASI_STATIC_KE_IE = 0.1
+"""A run whose kinetic energy exceeds this fraction of the internal energy is flagged as not quasi-static."""
+OUTPUTS = ("frames_*.vtu", "frames.pvd", "summary.json", "shear_angle.png", "deviation.png", "punch_force.png")
+"""What a run writes into its folder (a rerun replaces all of it)."""
 
 
 def add_parser(subparsers) -> None:
@@ -38,20 +46,19 @@ def add_parser(subparsers) -> None:
 
 
 def point_data(fields: dict, ply_id) -> dict:
-    """The VTU point fields of a frame (names with their unit in :data:`FIELD_UNITS`)."""
+    """The VTU point fields of a frame, named with their unit (:data:`FIELD_UNITS`)."""
     import numpy as np
 
-    out = {
-        "displacement": fields["displacement"],
+    return {
+        "displacement_m": fields["displacement"],
         "shear_angle_deg": np.degrees(fields["shear_angle"]),
         "fibre_strain": fields["fibre_strain"],
-        "bending_moment": fields["bending_moment"],
-        "M_f_rms": fields["M_f_rms"],
-        "contact_pressure": fields["contact_pressure"],
-        "deviation": fields["deviation"],
+        "bending_moment_N": fields["bending_moment"],
+        "M_f_rms_N": fields["M_f_rms"],
+        "contact_pressure_Pa": fields["contact_pressure"],
+        "deviation_m": fields["deviation"],
         "ply_id": np.asarray(ply_id),
     }
-    return out
 
 
 def execute(case, out, *, force=False, quiet=False, stream=None, element_size=None, overrides=(), owner="run",
@@ -67,7 +74,7 @@ def execute(case, out, *, force=False, quiet=False, stream=None, element_size=No
     from jaxform.io.output import prepare_output_dir
 
     case = cases.resolve(case, element_size=element_size, overrides=overrides)
-    out = prepare_output_dir(out, force=force, owner=owner)
+    out = prepare_output_dir(out, force=force, owner=owner, replaces=OUTPUTS)
     summary_path = out / "summary.json"
     t0 = time.perf_counter()
 
@@ -108,7 +115,7 @@ def _plots(result, out):
 
     paths = [save(fplots.shear_map(result), out / "shear_angle.png"),
              save(fplots.deviation_map(result), out / "deviation.png")]
-    if len(result.history["t"]) >= 2:
+    if len(result.history["t_s"]) >= 2:
         paths.append(save(fplots.punch_force_curve(result), out / "punch_force.png"))
     return paths
 
@@ -127,6 +134,10 @@ def report(result, written, out, stream=None):
         if s.get("max_ke_ie") is not None:
             print(f", max KE/IE {s['max_ke_ie']:.3g}", end="", file=stream)
         print(file=stream)
+        if s.get("max_ke_ie") is not None and s["max_ke_ie"] > QUASI_STATIC_KE_IE:
+            print(f"  warning: not quasi-static by its own numbers: the kinetic energy reached {s['max_ke_ie']:.3g} x "
+                  f"the internal energy over the last 80% of the stroke (quasi-static: below {QUASI_STATIC_KE_IE:g}); "
+                  "inertia shapes this result. Lower process.speed_mm_per_s.", file=stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)
     for p in written:
         print(f"  {p}", file=stream)
@@ -139,6 +150,10 @@ def run(args) -> int:
     report(result, written, args.out)
     if result.complete:
         return 0
+    from jaxform.cli import TERMINATED
+
+    if result.reason == TERMINATED:
+        return 143
     if result.reason and "KeyboardInterrupt" in result.reason:
         return 130
     return 1

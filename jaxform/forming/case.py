@@ -341,8 +341,12 @@ def _build(d) -> Case:
     if not 0 < c["safety"] < 1:
         raise _err("contact.safety", c["safety"], "must lie in (0, 1)")
     _positive(d, "slip_velocity_fraction", "contact")
-    if c["damping_ratio"] < 0:
-        raise _err("contact.damping_ratio", c["damping_ratio"], "must be >= 0")
+    zeta_stable = _stable_damping_ratio(c["safety"]) if k == "auto" else math.inf
+    if not 0 <= c["damping_ratio"] <= min(1.0, zeta_stable):
+        raise _err("contact.damping_ratio", c["damping_ratio"],
+                   f"must lie in [0, {min(1.0, zeta_stable):.3g}]: 1 is critical damping (beyond it the contact "
+                   "turns sticky)" + (f"; with contact.safety = {c['safety']:g} the explicit step is stable only up "
+                                      f"to {zeta_stable:.3g}" if zeta_stable < 1.0 else ""))
     contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=c["safety"],
                                slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"])
 
@@ -365,6 +369,29 @@ def _build(d) -> Case:
     return case
 
 
+def _stable_damping_ratio(safety: float) -> float:
+    """Largest contact damping ratio a stable explicit step allows with the automatic stiffness.
+
+    The automatic penalty stiffness is ``k = safety rho_A / dt^2``, so the contact oscillator has
+    ``omega dt = sqrt(safety)``; central differences with velocity damping stay stable while
+    ``omega dt <= 2 (sqrt(1 + zeta^2) - zeta)``, i.e. ``zeta <= (4 - safety) / (4 sqrt(safety))``.
+    """
+    return (4.0 - safety) / (4.0 * math.sqrt(safety))
+
+
+def _check_shear_poly(coeffs) -> None:
+    """A custom shear law must resist shear: positive initial stiffness and a positive force up to 60°."""
+    key = "fabric.shear_poly_N_per_m"
+    if not coeffs[0] > 0:
+        raise _err(key, list(coeffs), "the first coefficient (the initial shear stiffness, N/m) must be > 0")
+    for deg in range(1, 61):
+        g = math.radians(deg)
+        force = sum(c * g ** (i + 1) for i, c in enumerate(coeffs))
+        if not force > 0:
+            raise _err(key, list(coeffs), f"the shear force must be positive for shear angles up to 60 degrees "
+                       f"(it is {force:.4g} N/m at {deg} degrees): a negative force would shear the fabric by itself")
+
+
 def _check_setup(case: Case) -> None:
     """Impossible rigs, each refused with the key to change."""
     t, mm = case.tools, 1e3
@@ -382,6 +409,12 @@ def _check_setup(case: Case) -> None:
         raise _err("tools.punch_radius_mm", t.punch_radius * mm,
                    f"the punch and the stack ({stack * mm:g} mm) must pass through the die opening "
                    f"(tools.die_opening_radius_mm = {t.die_opening_radius * mm:g})")
+    if t.punch_mesh is None and not t.punch_radius + stack < t.holder_opening_radius:
+        raise _err("tools.holder_opening_radius_mm", t.holder_opening_radius * mm,
+                   f"the punch and the stack ({stack * mm:g} mm) must pass through the holder opening: it must "
+                   f"exceed tools.punch_radius_mm + stack = {(t.punch_radius + stack) * mm:g} mm")
+    if case.fabric.shear_poly is not None:
+        _check_shear_poly(case.fabric.shear_poly)
     if case.holder.mode == "gap" and not case.holder.gap > stack:
         raise _err("holder.gap_mm", case.holder.gap * mm,
                    f"must exceed the stack thickness {stack * mm:g} mm ({case.n_plies} plies)")

@@ -3,7 +3,10 @@ that writes frames as they come (callbacks for progress and output).
 
 ``simulate(case)`` = ``run(build(case))``: the rig is built once. The run's health is checked by the integrator itself, every step (non-finite values, or an
 energy-balance residual above half the largest energy seen, with a floor of :data:`ENERGY_FLOOR`
-so that float32 rounding at the start of a run never counts); the driver only reads the record.
+so that float32 rounding at the start of a run never counts); the driver reads that record and
+checks after every chunk that the run stays physical (fibre strain, node speeds, the part inside
+the rig: :class:`~jaxform.forming.rig.HealthBounds`). A run that fails either way stops with
+``complete = False``, the step, time and cause, and the frames up to the last good one.
 """
 from __future__ import annotations
 
@@ -17,7 +20,7 @@ import numpy as np
 
 from jaxform import integrate
 from jaxform.forming.case import Case
-from jaxform.forming.fields import ENERGY_KEYS, SCALARS, fields_jit
+from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS, SCALARS, fields_jit
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, RunInfo, build
 from jaxform.forming.summary import summarize
@@ -63,7 +66,9 @@ class FormingResult:
     Attributes:
         t: (F,) frame times, s; x: (F, N, 3) positions, m; fields: dict of (F, N, ...) nodal
             fields (see :func:`jaxform.forming.fields.state_fields`); history: dict of (S,) sampled
-            time series (``t``, ``punch_displacement``, ``punch_force``, ``holder_force``, energies...);
+            time series, keys named with their unit as in ``summary.json`` (``t_s``,
+            ``punch_displacement_m``, ``punch_force_N``, ``kinetic_J``...:
+            :data:`jaxform.forming.fields.HISTORY_KEYS`);
         faces, ply_id: mesh connectivity (F, 4) and (N,) ply numbers; info: :class:`RunInfo`;
         complete: bool; reason: why it stopped early (None when complete); wall_time_s; summary:
         dict (see :func:`jaxform.forming.summary.summarize`); final_state: last
@@ -107,15 +112,15 @@ class _Recorder:
     def __init__(self, on_frame):
         self.on_frame = on_frame
         self.t, self.x, self.fields = [], [], {}
-        self.hist: dict[str, list] = {k: [] for k in ("t", "step") + SCALARS + ENERGY_KEYS}
+        self.hist: dict[str, list] = {k: [] for k in HISTORY_KEYS.values()}
 
     def sample(self, s, fl):
-        self.hist["t"].append(float(s.t))
+        self.hist["t_s"].append(float(s.t))
         self.hist["step"].append(int(s.step))
         for k in SCALARS:
-            self.hist[k].append(float(fl[k]))
+            self.hist[HISTORY_KEYS[k]].append(float(fl[k]))
         for k in ENERGY_KEYS:
-            self.hist[k].append(float(getattr(s.energies, k)))
+            self.hist[HISTORY_KEYS[k]].append(float(getattr(s.energies, k)))
 
     def frame(self, s, fl):
         k = len(self.t)
@@ -126,6 +131,32 @@ class _Recorder:
             self.fields.setdefault(kk, []).append(v)
         if self.on_frame is not None:
             self.on_frame(k, float(s.t), self.x[-1], host)
+
+
+def _check_health(state, fl, info: RunInfo, last_good) -> None:
+    """Raise :class:`~jaxform.integrate.SimulationError` when the run left the physical bounds of
+    ``info.bounds`` (a run can blow up without a NaN or an energy-balance jump: nodes flung away
+    by an over-damped contact still balance their energy)."""
+    b = info.bounds
+    x = np.asarray(state.x)
+    strain, speed = float(fl["max_fibre_strain"]), float(fl["max_node_speed"])
+    causes = []
+    if not strain <= b.fibre_strain:
+        causes.append(f"fibre strain {strain:.3g} beyond {b.fibre_strain:g} (the fibres carry < 0.01)")
+    if not speed <= b.speed:
+        causes.append(f"a node moves at {speed:.3g} m/s, beyond {b.speed:.3g} m/s (100 x the punch speed)")
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    if not (np.all(lo >= np.asarray(b.box_lo)) and np.all(hi <= np.asarray(b.box_hi))):
+        far = max(float(np.max(np.asarray(b.box_lo) - lo)), float(np.max(hi - np.asarray(b.box_hi))))
+        causes.append(f"the part left the rig (nodes {far * 1e3:.3g} mm outside the box of twice the blank)")
+    if not causes:
+        return
+    step, t = int(state.step), float(state.t)
+    raise integrate.SimulationError(
+        f"the run left its physical bounds near step {step} (t = {t:.6e} s, punch {float(fl['punch_displacement']) * 1e3:.2f} "
+        f"mm): {'; '.join(causes)}. Likely cause: an unstable or badly set-up run (time step, contact stiffness or "
+        "damping, mass scaling); the frames up to the last good one are kept.",
+        step=step, time=t, cause="; ".join(causes), frames=_single_frame(last_good), state=last_good)
 
 
 def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False,
@@ -160,19 +191,24 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
                 for _ in range(info.samples_per_frame):
                     new = _run_steps_jit(model, state, e0, x_ref, n=info.sub_steps, energy_floor=floor)
                     if int(new.bad_step) >= 0:
-                        integrate.check(new, _single_frame(new), model)
+                        raise integrate.SimulationError(
+                            integrate.describe_failure(new, model) + " The frames up to the last good one are kept.",
+                            step=int(new.bad_step), time=int(new.bad_step) * info.dt,
+                            cause=integrate.failure_cause(new),
+                            frames=_single_frame(new), state=new)
+                    fl = fields_jit(model, new, ply_arr, n_plies=n_plies)
+                    _check_health(new, fl, info, state)
                     state = new
-                    fl = fields_jit(model, state, ply_arr, n_plies=n_plies)
                     rec.sample(state, fl)
                     if on_progress is not None:
                         on_progress(int(state.step), info.n_steps, float(state.t), float(fl["punch_displacement"]),
                                     time.perf_counter() - t_wall)
                 rec.frame(state, fl)
             complete = True
-    except KeyboardInterrupt:
+    except KeyboardInterrupt as err:
         if not catch:
             raise
-        reason = "interrupted by the user (KeyboardInterrupt)"
+        reason = str(err) or "interrupted by the user (KeyboardInterrupt)"
     except integrate.SimulationError as err:
         if not catch:
             raise

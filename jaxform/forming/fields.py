@@ -10,11 +10,17 @@ from jaxform.forming.rig import DIE, HOLDER, PUNCH
 from jaxform.metrics.wrinkles import rms_fibre_moment
 from jaxform.shell import fibre_curvatures, fibre_vectors, shear_angle
 
-SCALARS = ("punch_force", "punch_displacement", "holder_force", "holder_dz", "contact_energy", "friction_power")
+SCALARS = ("punch_force", "punch_displacement", "holder_force", "holder_dz", "contact_energy", "friction_power",
+           "max_fibre_strain", "max_node_speed")
 """Keys of :func:`state_fields` that are scalars (sampled as histories, not written as frames)."""
 ENERGY_KEYS = ("kinetic", "tension", "shear", "bending", "gravity_work", "external_work", "boundary_work",
                "damping_work")
 """Energy accounts of a state (:class:`jaxform.model.Energies`, J) sampled as histories."""
+HISTORY_KEYS = {"t": "t_s", "step": "step", "punch_force": "punch_force_N", "punch_displacement": "punch_displacement_m",
+                "holder_force": "holder_force_N", "holder_dz": "holder_dz_m", "contact_energy": "contact_energy_J",
+                "friction_power": "friction_power_W", "max_fibre_strain": "max_fibre_strain",
+                "max_node_speed": "max_node_speed_m_per_s", **{k: f"{k}_J" for k in ENERGY_KEYS}}
+"""Sampled quantity -> its key in a run's history (``FormingResult.history``, ``summary.json``): name_unit."""
 
 
 def node_average(values, mesh, n: int):
@@ -57,7 +63,8 @@ def state_fields(model, state, ply_id, n_plies: int):
     side, die for ply n's side), ``min(phi_punch - (i - 1/2) h, phi_die - (n - i + 1/2) h)``;
     ``punch_force`` () N (vertical reaction on the punch, positive resisting its descent),
     ``punch_displacement`` () m (downwards positive), ``holder_force`` () N, ``holder_dz`` () m,
-    ``contact_energy`` () J, ``friction_power`` () W.
+    ``contact_energy`` () J, ``friction_power`` () W, ``max_fibre_strain`` () largest ``|g_f| - 1``
+    of any element, ``max_node_speed`` () m/s (the run's physical health, :mod:`jaxform.forming.driver`).
     """
     shell = model.shell
     mesh = shell.mesh
@@ -71,7 +78,9 @@ def state_fields(model, state, ply_id, n_plies: int):
            "shear_angle": node_average(shear_angle(g, shell.ref), mesh, n),
            "fibre_strain": node_average(stretch, mesh, n),
            "bending_moment": M,
-           "M_f_rms": rms_fibre_moment(M[:, 0], M[:, 1])}
+           "M_f_rms": rms_fibre_moment(M[:, 0], M[:, 1]),
+           "max_fibre_strain": jnp.max(jnp.abs(stretch)),
+           "max_node_speed": jnp.sqrt(jnp.max(jnp.sum(state.v * state.v, axis=-1)))}
     pressure = jnp.zeros((n,), dtype)
     phis, tool = [], {}
     for i, (load, ls) in enumerate(zip(model.loads[:3], state.loads[:3])):
@@ -100,4 +109,4 @@ def state_fields(model, state, ply_id, n_plies: int):
 fields_jit = jax.jit(state_fields, static_argnames=("n_plies",))
 """:func:`state_fields` compiled (one program per rig shape)."""
 
-__all__ = ["SCALARS", "ENERGY_KEYS", "node_average", "state_fields", "fields_jit"]
+__all__ = ["SCALARS", "ENERGY_KEYS", "HISTORY_KEYS", "node_average", "state_fields", "fields_jit"]

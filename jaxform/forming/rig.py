@@ -55,6 +55,7 @@ class RunInfo:
         edge_mid: (4,) node indices of ply 1's edge mid-sides (+x, -x, +y, -y); corners: (4,).
         n_ply_loads: number of ply–ply loads (after the three tools).
         stable_dt: stable estimate of the shell alone, s.
+        bounds: :class:`HealthBounds` the driver checks after every chunk.
     """
 
     case: Any
@@ -71,6 +72,7 @@ class RunInfo:
     corners: np.ndarray
     n_ply_loads: int
     stable_dt: float
+    bounds: HealthBounds
 
     @property
     def sub_steps(self) -> int:
@@ -79,6 +81,35 @@ class RunInfo:
     def __repr__(self) -> str:
         return (f"RunInfo(case={self.case.name!r}, nodes={len(self.x0)}, dt={self.dt:.3e} s, "
                 f"n_steps={self.n_steps}, n_frames={self.n_frames})")
+
+
+@dataclasses.dataclass(frozen=True)
+class HealthBounds:
+    """Bounds a physically sound forming run never crosses (derived from the case by :func:`health_bounds`).
+
+    Attributes:
+        fibre_strain: largest ``|fibre strain|`` of any element (the fibres' 3 GPa modulus keeps
+            real strains below 1%); speed: largest node speed, m/s; box_lo, box_hi: (3,) corners
+            of the box the part stays in, m.
+    """
+
+    fibre_strain: float
+    speed: float
+    box_lo: tuple
+    box_hi: tuple
+
+
+def health_bounds(case: Case) -> HealthBounds:
+    """The bounds of :class:`HealthBounds` for a case: fibre strain 10% (ten times what the fibres
+    carry), node speed 100 times the punch speed (at least 10 m/s: a snap-through of the flange
+    stays well below), and a box of twice the blank's half-size across, from the punch's lowest
+    reach minus a blank half-size below to the holder's top plus a blank half-size above."""
+    half = 0.5 * case.blank_size
+    t = case.tools
+    top = (case.holder.gap or case.stack_thickness) + t.holder_thickness + half
+    bottom = -(case.process.stroke + t.die_thickness + half)
+    return HealthBounds(fibre_strain=0.1, speed=max(100.0 * case.process.speed, 10.0),
+                        box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top))
 
 
 class Rig(NamedTuple):
@@ -345,7 +376,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
                    ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,
-                   n_ply_loads=case.n_plies - 1, stable_dt=stable)
+                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case))
     return Rig(model, state, info)
 
 
@@ -361,5 +392,5 @@ def with_fabric(model, fabric):
     return model.replace(shell=model.shell.replace(fabrics=fabs))
 
 
-__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
+__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
            "ply_fabrics", "punch_motion", "stroke_time", "build_tools", "with_fabric"]

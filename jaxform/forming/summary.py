@@ -8,7 +8,7 @@ import jax
 import numpy as np
 
 from jaxform.forming.case import to_dict
-from jaxform.forming.fields import ENERGY_KEYS
+from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS
 from jaxform.forming.rig import RunInfo
 
 
@@ -92,10 +92,11 @@ def summarize(result) -> dict:
     info = result.info
     case = info.case
     h = result.history
-    ie = h["tension"] + h["shear"] + h["bending"] if len(h["t"]) else np.zeros(0)
-    ke = h["kinetic"] if len(h["t"]) else np.zeros(0)
+    n = len(h["t_s"])
+    ie = h["tension_J"] + h["shear_J"] + h["bending_J"] if n else np.zeros(0)
+    ke = h["kinetic_J"] if n else np.zeros(0)
     T = info.stroke_time
-    late = h["t"] >= 0.2 * T if len(h["t"]) else np.zeros(0, bool)
+    late = h["t_s"] >= 0.2 * T if n else np.zeros(0, bool)
     ratio = np.where(ie > 0, ke / np.maximum(ie, 1e-300), np.inf) if len(ie) else ie
     max_ke_ie = float(np.max(ratio[late])) if np.any(late) else None
     if max_ke_ie is not None and not math.isfinite(max_ke_ie):
@@ -129,15 +130,10 @@ def summarize(result) -> dict:
         "frames_written": int(len(result.t)),
         "frame_times_s": result.t.tolist(),
         "history": {
-            "t_s": h["t"].tolist(),
-            "punch_displacement_m": h["punch_displacement"].tolist(),
-            "punch_force_N": h["punch_force"].tolist(),
-            "holder_force_N": h["holder_force"].tolist(),
-            "energies_J": {k: h[k].tolist() for k in ENERGY_KEYS},
+            **{k: v.tolist() for k, v in h.items() if k not in {HISTORY_KEYS[e] for e in ENERGY_KEYS}},
+            "energies_J": {k: h[HISTORY_KEYS[k]].tolist() for k in ENERGY_KEYS},
             "internal_energy_J": ie.tolist(),
             "ke_ie": [None if not np.isfinite(r) else float(r) for r in ratio],
-            "contact_energy_J": h["contact_energy"].tolist(),
-            "friction_power_W": h["friction_power"].tolist(),
         },
         "versions": {"jaxform": jaxform.__version__, "jax": jax.__version__, "numpy": np.__version__},
     }

@@ -11,13 +11,16 @@ import pathlib
 MARKER = ".jaxform-output"
 
 
-def prepare_output_dir(path, *, force: bool = False, owner: str = "jaxform") -> pathlib.Path:
+def prepare_output_dir(path, *, force: bool = False, owner: str = "jaxform", replaces=()) -> pathlib.Path:
     """Create or reuse an output directory.
 
     Args:
         path: directory to write into.
         force: allow writing into a non-empty directory that this command did not create.
         owner: name of the command writing there (recorded in the marker file).
+        replaces: glob patterns of the files a run of ``owner`` writes (``"frames_*.vtu"``...): those
+            left by an earlier run are removed first, so that two runs' outputs never mix (a rerun
+            with fewer frames would otherwise leave stale frames beside the new ``.pvd``).
 
     Returns:
         The directory as a ``pathlib.Path``.
@@ -38,5 +41,9 @@ def prepare_output_dir(path, *, force: bool = False, owner: str = "jaxform") -> 
                 "choose another directory or pass --force to write into it"
             )
     out.mkdir(parents=True, exist_ok=True)
+    for pattern in replaces:
+        for old in out.glob(pattern):
+            if old.is_file():
+                old.unlink()
     marker.write_text(owner + "\n")
     return out

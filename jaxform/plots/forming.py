@@ -16,12 +16,20 @@ def _top_ply(result, k: int = -1):
     return result.x[k][idx], remap[faces], idx
 
 
+def _title(result, what: str, k: int) -> str:
+    """``"<case>: <what>, punch <d> mm"`` for frame ``k`` (the punch displacement at the frame's time)."""
+    h = result.history
+    t = result.t[k]
+    d = float(np.interp(t, h["t_s"], h["punch_displacement_m"])) if len(h["t_s"]) else 0.0
+    return f"{result.info.case.name}: {what}, punch {d * 1e3:.1f} mm"
+
+
 def shear_map(result, k: int = -1):
     """Shear angle (degrees) of ply 1 at frame ``k``, top view of the deformed ply."""
     x, faces, idx = _top_ply(result, k)
     g = np.degrees(result.fields["shear_angle"][k][idx])
     lim = max(float(np.max(np.abs(g))), 1e-6)
-    return field_map(x, faces, g, title=f"shear angle, t = {result.t[k] * 1e3:.1f} ms", label="shear angle (°)",
+    return field_map(x, faces, g, title=_title(result, "shear angle", k), label="shear angle (°)",
                      cmap="RdBu_r", vmin=-lim, vmax=lim)
 
 
@@ -29,14 +37,14 @@ def deviation_map(result, k: int = -1):
     """Out-of-plane deviation from the tool surface (mm) of ply 1 at frame ``k``."""
     x, faces, idx = _top_ply(result, k)
     d = np.maximum(result.fields["deviation"][k][idx], 0.0) * 1e3
-    return field_map(x, faces, d, title=f"deviation from the tools, t = {result.t[k] * 1e3:.1f} ms",
+    return field_map(x, faces, d, title=_title(result, "deviation from the tools", k),
                      label="deviation (mm)", cmap="magma")
 
 
 def punch_force_curve(result):
     """Punch force (N) against punch displacement (mm)."""
     h = result.history
-    return curve(np.asarray(h["punch_displacement"]) * 1e3, h["punch_force"], xlabel="punch displacement (mm)",
+    return curve(np.asarray(h["punch_displacement_m"]) * 1e3, h["punch_force_N"], xlabel="punch displacement (mm)",
                  ylabel="punch force (N)", title=f"{result.info.case.name}: punch force")
 
 

@@ -1,32 +1,20 @@
 """Safe vector maths and point–triangle geometry: the one home of the closest-point primitives.
 
-Pure JAX (the triangle index is built with numpy on the host, from concrete arrays; no files).
-Every other module takes its norms, normalisations and nearest-triangle searches from here
-(MJX ``math.py`` / ``collision_primitive.py`` in spirit).
+Pure JAX; the triangle index is built with numpy on the host from concrete arrays (no files).
 
-Safe helpers
-    :func:`safe_norm`, :func:`safe_normalize`, :func:`safe_sqrt`, :func:`safe_div`: the usual
-    operations with a *finite* gradient where the plain one is NaN or infinite (at the zero
-    vector, at ``sqrt(0)``, at a zero denominator): the ``jnp.where`` double-branch trick, so the
-    value is exact away from the singular point.
-
-Point–triangle
-    :func:`closest_point_triangle` returns the closest point of a triangle and its barycentric
-    weights (Voronoi regions, Ericson's *Real-Time Collision Detection* 5.1.5), broadcasting over
-    leading axes; zero-area triangles are handled as the union of their edges.
-    :func:`point_triangle_sqdist` is ``|p - q|**2`` of that point.
-
-Nearest triangle of a mesh (certified)
-    :class:`TriangleIndex` groups a static triangle mesh, host side (:func:`build_triangle_index`),
-    into spatially compact clusters (Morton order of the centroids, ``G`` triangles each) and
-    super-clusters, each with a bounding sphere and box. :func:`closest_triangle` searches, for
-    each point, the ``k`` clusters whose bounds come closest and certifies the answer when no
-    unsearched bound is closer than the distance found; uncertified points get a wider second
-    pass, then an exhaustive search (a ``lax.while_loop`` over fixed-size batches). The answer is
-    the exact closest triangle for every point. An index made as ``TriangleIndex(tri)`` (no
-    cluster tables, e.g. from traced vertices) is searched exhaustively: the brute-force mode of
-    the same function. :func:`closest_point_on_mesh` then recomputes the closest point from the
-    selected triangle with differentiable operations (the search itself picks integers).
+* :func:`safe_norm`, :func:`safe_normalize`, :func:`safe_sqrt`, :func:`safe_div`: exact values
+  away from the singular point, finite (zero) gradients at it (the double-``where`` trick).
+* :func:`closest_point_triangle`: closest point and barycentric weights (Voronoi regions,
+  Ericson, *Real-Time Collision Detection* 5.1.5; zero-area triangles as the union of their
+  edges); :func:`point_triangle_sqdist` is ``|p - q|**2`` of that point.
+* :func:`closest_triangle` / :func:`closest_point_on_mesh`: the certified nearest triangle of a
+  static mesh. :func:`build_triangle_index` groups the triangles (Morton order of the centroids)
+  into clusters and super-clusters with bounding spheres and boxes; each point searches the
+  clusters whose bounds come closest, and the answer is certified when no unsearched bound is
+  closer than the distance found; uncertified points get a wider second pass, then an exhaustive
+  search (``lax.while_loop`` over fixed-size batches): exact for every point. ``TriangleIndex(tri)``
+  without clusters (e.g. traced triangles) is the brute-force mode of the same search.
+* :func:`nearest_centroids`: uncertified candidates of a *moving* mesh (ply–ply contact).
 """
 from __future__ import annotations
 
@@ -54,8 +42,7 @@ __all__ = [
     "quads_to_triangles",
 ]
 
-EZ = (0.0, 0.0, 1.0)
-"""The fallback direction of :func:`safe_normalize` (``+z``)."""
+EZ = (0.0, 0.0, 1.0)  # the fallback direction of safe_normalize
 
 
 # ---------------------------------------------------------------------------------------------
@@ -64,25 +51,13 @@ EZ = (0.0, 0.0, 1.0)
 
 
 def safe_sqrt(x):
-    """``sqrt(x)`` for ``x > 0``, 0 elsewhere; gradient 0 (not inf/NaN) at and below 0.
-
-    Args:
-        x: (...) array, any unit u².
-    Returns:
-        (...) array, unit u.
-    """
+    """``sqrt(x)`` of a (...) array (unit u²) for ``x > 0``, else 0 (unit u); gradient 0 at and below 0."""
     ok = x > 0.0
     return jnp.where(ok, jnp.sqrt(jnp.where(ok, x, 1.0)), 0.0)
 
 
 def safe_norm(v, axis=-1, keepdims=False):
-    """Euclidean norm along ``axis`` whose gradient is 0 (not NaN) at the zero vector.
-
-    Args:
-        v: (..., 3) (or any size along ``axis``) vectors, unit u.
-    Returns:
-        (...) norms, unit u (``keepdims``: the axis kept with size 1).
-    """
+    """Norms (...) of vectors (..., 3) (components along ``axis``), unit u; gradient 0 at zero."""
     return safe_sqrt(jnp.sum(v * v, axis=axis, keepdims=keepdims))
 
 
@@ -104,11 +79,7 @@ def safe_normalize(v, fallback=EZ, tiny=1e-30):
 
 
 def safe_div(x, y, default=0.0):
-    """``x / y`` where ``y != 0``, ``default`` elsewhere; finite gradient everywhere.
-
-    Args:
-        x, y: broadcastable arrays.
-    """
+    """``x / y`` (broadcast) where ``y != 0``, ``default`` elsewhere; finite gradient everywhere."""
     ok = y != 0
     return jnp.where(ok, x / jnp.where(ok, y, 1.0), default)
 
@@ -195,13 +166,8 @@ def closest_point_triangle(p, a, b, c):
 
 
 def point_triangle_sqdist(p, a, b, c):
-    """Squared distance from points to triangles: ``|p - q|**2`` of :func:`closest_point_triangle`.
-
-    Args:
-        p, a, b, c: (..., 3) points, m (broadcast).
-    Returns:
-        (...) squared distance, m².
-    """
+    """Squared distance (...), m², of points ``p`` to triangles ``abc`` ((..., 3), m, broadcast):
+    ``|p - q|**2`` with ``q`` from :func:`closest_point_triangle`."""
     q, _ = closest_point_triangle(p, a, b, c)
     d = jnp.asarray(p) - q
     return jnp.sum(d * d, axis=-1)
@@ -334,10 +300,6 @@ def build_triangle_index(vertices, faces, *, cluster_size: int = 8, super_size: 
     )
 
 
-def _columns(p):
-    return p[:, 0:1], p[:, 1:2], p[:, 2:3]
-
-
 def _brute(points, tri, *, node_batch: int = 64, tri_batch: int = 4096):
     """Closest triangle id (N,) int32 of each point (N, 3) among ``tri`` (F, 3, 3): exhaustive."""
     n_tri = tri.shape[0]
@@ -351,7 +313,7 @@ def _brute(points, tri, *, node_batch: int = 64, tri_batch: int = 4096):
         def body(carry, chunk):
             best_d, best_i = carry
             t, base = chunk  # t (9, tb)
-            d = _sqdist_soa(_columns(p), tuple(t[i][None, :] for i in range(9)))
+            d = _sqdist_soa((p[:, 0:1], p[:, 1:2], p[:, 2:3]), tuple(t[i][None, :] for i in range(9)))
             j = jnp.argmin(d, axis=1)
             dj = jnp.take_along_axis(d, j[:, None], axis=1)[:, 0]
             better = dj < best_d
@@ -376,7 +338,7 @@ def _lower_bound(p, bounds):
     The larger of the bounding-sphere and bounding-box distances: a lower bound of the distance
     from the point to anything inside the group."""
     cx, cy, cz, r, lx, ly, lz, hx, hy, hz = bounds
-    px, py, pz = _columns(p)
+    px, py, pz = p[:, 0:1], p[:, 1:2], p[:, 2:3]
     lb_sphere = safe_sqrt((px - cx) ** 2 + (py - cy) ** 2 + (pz - cz) ** 2) - r
     ox = jnp.maximum(jnp.maximum(lx - px, px - hx), 0.0)
     oy = jnp.maximum(jnp.maximum(ly - py, py - hy), 0.0)
@@ -415,7 +377,7 @@ def _cluster_search(p, index: TriangleIndex, ks: int, k: int, dtype):
     sel_c, next_c = _smallest(lb_c, k)
     cl_sel = jnp.take_along_axis(cl, sel_c, axis=1)  # (B, k)
     tids = jnp.asarray(index.cluster_tri)[cl_sel].reshape(p.shape[0], -1)
-    d = _sqdist_soa(_columns(p), tuple(tri9[i][tids] for i in range(9)))
+    d = _sqdist_soa((p[:, 0:1], p[:, 1:2], p[:, 2:3]), tuple(tri9[i][tids] for i in range(9)))
     j = jnp.argmin(d, axis=1)
     best = jnp.take_along_axis(tids, j[:, None], axis=1)[:, 0]
     dmin = safe_sqrt(jnp.take_along_axis(d, j[:, None], axis=1)[:, 0])
@@ -467,12 +429,8 @@ def _indexed(points, index: TriangleIndex, node_chunk: int = 1024):
 def closest_triangle(points, index: TriangleIndex):
     """Id of the closest triangle of ``index`` to each point, exact for every point.
 
-    Args:
-        points: (N, 3) positions, m (floating).
-        index: :class:`TriangleIndex` (cluster search; brute force when it has no clusters).
-
-    Returns:
-        (N,) int32 triangle ids (no gradient: integers).
+    ``points``: (N, 3), m; ``index``: :class:`TriangleIndex` (brute force when it has no
+    clusters). Returns (N,) int32 triangle ids (integers: no gradient).
     """
     points = jax.lax.stop_gradient(jnp.asarray(points))
     if index.cluster_tri is None:

@@ -134,9 +134,12 @@ def _cross(a, b):
     return jnp.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
 
 
-def _safe_norm(v):
-    """Norm of structure-of-arrays vectors (3, ...), zero gradient at zero (:mod:`jaxform.geometry`)."""
+def _norm(v):
+    """Norm of SoA vectors (3, ...): geometry's safe_sqrt of the kernels' dot (zero gradient at 0)."""
     return safe_sqrt(_dot(v, v))
+
+
+_safe_norm = _norm  # the old name, still imported by jaxform.fibre_mass
 
 
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on
@@ -168,7 +171,7 @@ def _fibres_soa(e1, e2, coef):
 
 def _angle(g1, g2):
     cr = _cross(g1, g2)
-    return jnp.arctan2(_safe_norm(cr), _dot(g1, g2))
+    return jnp.arctan2(_norm(cr), _dot(g1, g2))
 
 
 def fibre_vectors(x, mesh: Mesh, ref: ShellRef):
@@ -220,7 +223,7 @@ def _curvatures_soa(D, node_dir):
     """Fibre curvatures (2, N) from SoA derivatives (5, 3, N) and fibre dirs (N, 2, 2)."""
     xX, xY, xXX, xXY, xYY = D[0], D[1], D[2], D[3], D[4]
     nrm = _cross(xX, xY)
-    n = nrm / _safe_norm(nrm)
+    n = nrm / _norm(nrm)
     out = []
     for f in range(2):
         c, s = node_dir[:, f, 0], node_dir[:, f, 1]
@@ -304,8 +307,8 @@ def _membrane_density(e1, e2, shell: Shell, t0: int, t1: int, fab):
     ref = shell.ref
     dtype = e1.dtype
     g1, g2 = _fibres_soa(e1, e2, ref.tri_coef[t0:t1].astype(dtype))
-    l1 = _safe_norm(g1)
-    l2 = _safe_norm(g2)
+    l1 = _norm(g1)
+    l2 = _norm(g2)
     eh = jnp.broadcast_to(jnp.asarray(fab.fibre_modulus * fab.thickness, dtype), (2,))
     a = ref.tri_area[t0:t1].astype(dtype)
     tension = 0.5 * a * (eh[0] * (l1 - 1.0) ** 2 + eh[1] * (l2 - 1.0) ** 2)

@@ -139,9 +139,6 @@ def _norm(v):
     return safe_sqrt(_dot(v, v))
 
 
-_safe_norm = _norm  # the old name, still imported by jaxform.fibre_mass
-
-
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on
 # CPU, where (n, 3) layouts with tiny trailing axes do not (measured: 5-10x).
 

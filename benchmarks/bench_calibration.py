@@ -39,6 +39,7 @@ def run(quick: bool = False) -> dict:
         "n_profiles": len(profiles),
         "iterations": fit.iterations,
         "n_simulations": fit.n_simulations,
+        "n_evaluations": fit.n_evaluations,
         "b_init_rel_err": fit.b_init / b_init - 1,
         "b_inf_rel_err": fit.b_inf / true["b_inf"] - 1,
         "b_inf_determined": fit.b_inf_determined,

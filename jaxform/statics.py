@@ -24,6 +24,11 @@ components the caller asks it to predict).
 ``u* - H^-1 grad E(u*, p)`` with ``u*`` and ``H`` held constant is ``u*``, and its derivative with
 respect to anything ``E`` depends on (law parameters, masses, moduli, prescribed positions) is
 ``-H^-1 d(grad E)/dp``, in forward and reverse mode, without differentiating the iterations.
+
+Why not ``optimistix.root_find`` (Newton) with ``ImplicitAdjoint``: the rigs need what a plain
+root find does not give, an energy merit function (a Newton step on a nearly inextensible strip
+must not be taken unless the energy drops), a load path with a predictor, and a Hessian assembled
+by colouring; the adjoint is the same implicit-function theorem, written in four lines above.
 """
 from __future__ import annotations
 

@@ -204,9 +204,11 @@ def test_fit_cantilever_command(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(ROOT / "tests") + os.pathsep + os.environ.get("PYTHONPATH", ""))
     cmd = [sys.executable, str(ROOT / "calibration" / "fit_cantilever.py"), "--profile", str(csv), "--overhang-mm", "90",
            "--areal-mass-gsm", "210", "--out", str(out), "--plot", str(tmp_path / "fit.png"),
-           "--simulate", "test_calibration:simulate_small", "--no-standard-test"]
+           "--simulate", "test_calibration:simulate_small", "--no-standard-test", "--progress-every", "0"]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
     assert r.returncode == 0, r.stderr
+    # progress: stderr is a pipe here, so plain lines, one per optimiser iteration, then a summary
+    assert "fit [pos] iteration 1: rmse" in r.stderr and "fit [pos] done:" in r.stderr, r.stderr
     d = json.loads(out.read_text())
     b_init = TRUE["b_inf"] + TRUE["m0"] / TRUE["kappa0"]
     assert d["b_init_Nm"] == pytest.approx(b_init, rel=0.03)

@@ -374,10 +374,10 @@ def fit_cantilever(
     def jacobian(d):
         return np.concatenate([evaluate(tuple((q0 + d).tolist())).J, ridge])
 
-    def report(intermediate):
-        rmse = _RES_SCALE * math.sqrt(2.0 * float(intermediate.cost) / n_data)
-        callback(FitProgress(int(intermediate.nit), int(intermediate.nfev), rmse,
-                             law_from_q(jnp.asarray(q0 + intermediate.x, dtype), law)))
+    def report(intermediate_result):  # scipy passes the OptimizeResult to a parameter of this name
+        it = intermediate_result
+        rmse = _RES_SCALE * math.sqrt(2.0 * float(it.cost) / n_data)
+        callback(FitProgress(int(it.nit), int(it.nfev), rmse, law_from_q(jnp.asarray(q0 + it.x, dtype), law)))
 
     opt = least_squares(fun, np.zeros_like(q0), jac=jacobian, method=method, ftol=tol, xtol=tol,
                         max_nfev=max_iter, callback=report if callback is not None else None)
@@ -385,7 +385,7 @@ def fit_cantilever(
     final = evaluate(tuple(q.tolist()))  # cached: the optimiser evaluated its last iterate
     n_solves = evaluate.cache_info().misses
     solver_ok = final.converged
-    if not solver_ok:  # unreachable after an accepted step; kept for an ``init`` that fails
+    if not solver_ok:  # a safety net: the optimiser accepts only converged points
         warnings.warn(f"fit_cantilever: forward simulation residual {final.solver_residual.max():.2e} > "
                       f"{max_solver_residual:.1e} at the fitted law; the fit is not trustworthy", RuntimeWarning)
     fitted = law_from_q(jnp.asarray(q, dtype), law)

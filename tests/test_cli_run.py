@@ -29,7 +29,8 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert s["inputs"]["blank"]["element_size_mm"] == 25.0 and s["inputs"]["process"]["stroke_mm"] == 4.0
     assert s["versions"]["jax"] and s["versions"]["jaxform"]
     h = s["history"]
-    assert len(h["t_s"]) == len(h["punch_force_N"]) == len(h["energies_J"]["kinetic"]) > 10
+    # the force curve is sampled finely enough to read (item 11: ~20 samples before)
+    assert len(h["t_s"]) == len(h["punch_force_N"]) == len(h["energies_J"]["kinetic"]) >= 201
     assert h["punch_displacement_m"][-1] == pytest.approx(4e-3, rel=1e-3)
     assert set(s["draw_in"]) >= {"edge_mid_m", "corner_m"}
     frames = _pvd_files(tmp_out)

@@ -230,7 +230,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
 
 def simulate(case: Case, *, dtype=None, element_size: float | None = None, overrides=(),
              on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False, fabric=None,
-             samples_per_frame: int = 10, damping: float = 0.0, dt: float | None = None,
+             samples_per_frame: int | None = None, damping: float = 0.0, dt: float | None = None,
              build_only: bool = False) -> FormingResult:
     """Run a forming case: apply the overrides once, build the rig once, run it (:func:`run`).
 

@@ -326,8 +326,12 @@ def _ply_ids(mesh: Mesh) -> np.ndarray:
 # ---------------------------------------------------------------------------------------------
 
 
-def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75, samples_per_frame: int = 10,
-          fabric=None, damping: float = 0.0) -> Rig:
+MIN_SAMPLES = 200
+"""Default number of history samples over the stroke (punch force curve, energies): at least this many."""
+
+
+def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
+          samples_per_frame: int | None = None, fabric=None, damping: float = 0.0) -> Rig:
     """Build a forming run once: mesh, fabrics, shell, tools, contact loads, time step, initial state.
 
     Args:
@@ -336,7 +340,8 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
         dtype: ``"float32"``/``"float64"`` (default: the case's ``numerics.dtype``).
         dt: time step, s (default ``dt_safety`` times the stable estimate); rounded down to fill
             frame intervals with whole steps.
-        samples_per_frame: host chunks per frame interval (progress and force-curve samples).
+        samples_per_frame: host chunks per frame interval (progress and force-curve samples; default
+            at least 10 and enough for :data:`MIN_SAMPLES` samples over the stroke).
         fabric: a :class:`~jaxform.materials.Fabric` replacing the case's (e.g. custom laws).
         damping: mass-proportional damping, 1/s (default none).
 
@@ -352,6 +357,9 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     jdtype = jnp.float64 if dtype_name == "float64" else jnp.float32
     if int(case.process.frames) < 2:
         raise ValueError(f"case key 'process.frames' = {case.process.frames}: need at least 2 (start and end)")
+    n_int = int(case.process.frames) - 1
+    if samples_per_frame is None:
+        samples_per_frame = max(10, math.ceil(MIN_SAMPLES / n_int))
     samples_per_frame = int(samples_per_frame)
     if samples_per_frame < 1:
         raise ValueError("forming.build: samples_per_frame must be >= 1")
@@ -372,7 +380,6 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     # jitted: eager (op-by-op) evaluation of the shell forces costs seconds
     state = _init_state(model, tuple(load_states))
     mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
-    n_int = int(case.process.frames) - 1
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
                    ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,

@@ -38,11 +38,19 @@ def test_wrinkles_command_on_a_mesh_in_mm(sheet_mm, tmp_out, capsys):
     np.testing.assert_allclose(m.points, x, atol=1e-12)  # read in mm, written in m
     assert {"distance_m", "kappa_max_per_m", "zone", "k1_per_m"} <= set(m.point_data)
     assert np.all(np.isfinite(m.point_data["kappa_max_per_m"]))
-    # Refuses a non-empty output directory unless --force.
+    # A rerun into its own folder replaces it (the section file of the first run goes); a folder
+    # the command did not write is refused unless --force.
     args = ["wrinkles", str(path), "--tool", "hemisphere", "--ply-thickness-mm", "0.3", "--out", str(tmp_out)]
+    assert main(args) == 0
+    assert not (tmp_out / "section_0.csv").exists()
+    other = tmp_out.parent / "theirs"
+    other.mkdir()
+    (other / "notes.txt").write_text("keep")
+    args[-1] = str(other)
     assert main(args) == 2
     assert "not empty" in capsys.readouterr().err
     assert main(args + ["--force"]) == 0
+    assert (other / "notes.txt").read_text() == "keep"
 
 
 def test_tool_mesh_and_point_cloud(sheet_mm, tmp_path, capsys):
@@ -75,12 +83,11 @@ def test_bad_input_messages(sheet_mm, tmp_path, capsys):
     assert main(["wrinkles", str(path), "--tool", "cone"] + base) == 2
     assert "neither an existing file nor a preset" in capsys.readouterr().err
     assert main(["wrinkles", str(tmp_path / "missing.vtu"), "--tool", "plane"] + base) == 2
-    # Mixed units: the mesh declared in m while the tool is in m too but the mesh file is in mm.
-    tv, tf = np.array([[0, 0, 0], [0.1, 0, 0], [0, 0.1, 0.0]]), np.array([[0, 1, 2]])
+    # A tool file 1000 times smaller than the part (mixed units that the size guess cannot see).
+    tv, tf = np.array([[0, 0, 0.05], [1e-4, 0, 0.05], [0, 1e-4, 0.05]]), np.array([[0, 1, 2]])
     tool_path = tmp_path / "tool.obj"
     meshio.write(tool_path, meshio.Mesh(tv, [("triangle", tf)]))
-    with pytest.warns(UnitsWarning):
-        rc = main(["wrinkles", str(path), "--units", "m", "--tool", str(tool_path), "--tool-units", "m"] + base)
+    rc = main(["wrinkles", str(path), "--tool", str(tool_path), "--tool-units", "m"] + base)
     assert rc == 2 and "mixed units" in capsys.readouterr().err
     # NaN coordinates
     bad = x.copy()

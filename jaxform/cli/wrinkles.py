@@ -1,17 +1,45 @@
-"""``jaxform wrinkles``: the paper's wrinkle metric on any surface mesh (host side)."""
+"""``jaxform wrinkles``: the paper's wrinkle metric on any surface mesh (host side).
+
+The tool knows where it is. On a frame of a ``jaxform run`` folder (``frames_#####.vtu`` beside
+``frames.pvd`` and ``summary.json``), or with ``--tool run`` / ``--tool RUN_DIR``, the tool is the
+run's own rig (:func:`jaxform.forming.rig.build_tools` of the case in ``summary.json``): the punch
+moved down by its displacement at that frame's time, and the die. The blank holder is left out,
+like the run's ``deviation_m``: in the flange a wrinkle lifting towards it would look smaller.
+The ply thickness and index default to the run's.
+
+No plausible wrong answer with exit 0: every argument (sections included) is parsed and checked
+before any work; a mesh whose size contradicts ``--units``, nodes inside a tool, a tool far from
+the part, a ``--tool`` or ``--ply-thickness-mm`` that disagrees with the run the frame comes from
+are errors that say what to do. ``--force`` measures anyway (each overridden check is printed and
+recorded under ``forced`` in ``summary.json``) and also writes into a non-empty folder that is not
+a ``jaxform wrinkles`` output; a rerun into its own output folder replaces it without ``--force``.
+"""
 from __future__ import annotations
 
+import dataclasses
 import json
+import math
 import pathlib
+import re
+import sys
 import time
+import xml.etree.ElementTree as ET
 
 import numpy as np
 
 PRESETS = {
-    "hemisphere": "the paper's rig: hemispherical punch on a flat base plane "
-    "(hemisphere:radius_mm=50,x_mm=0,y_mm=0,z_mm=0,base=1)",
+    "hemisphere": "the paper's hemisphere as a male mould: punch apex up on a flat base plane "
+    "(hemisphere:radius_mm=50,x_mm=0,y_mm=0,z_mm=0,base=1); not the pose of a 'jaxform run' rig",
     "plane": "a flat tool z = const (plane:z_mm=0)",
+    "run": "the rig of the 'jaxform run' folder MESH is a frame of (the default for such a frame); "
+    "or give the run folder itself: --tool runs/a",
 }
+
+OUTPUTS = ("wrinkles.vtu", "summary.json", "distance.png", "kappa_max.png", "zones.png", "section_*.csv",
+           "cloud_distance.vtu", "cloud_distance.png")
+"""What the command writes into its folder (a rerun replaces all of it)."""
+
+_FRAME = re.compile(r"frames_(\d+)\.vtu$")
 
 
 def add_parser(subparsers) -> None:
@@ -22,16 +50,24 @@ def add_parser(subparsers) -> None:
         "meshio-readable surface (VTU, Abaqus .inp, OBJ, PLY, STL...): distance of every node to "
         "the tool, principal curvatures by iterative quadric fitting, wrinkle/bridging/conforming "
         "zones. Writes DIR/wrinkles.vtu, DIR/summary.json and PNG maps. With --cloud, also the "
-        "distance of every measured point to the surface (as CloudCompare does for scans).",
+        "distance of every measured point to the surface (as CloudCompare does for scans). "
+        "On a frame of a 'jaxform run' folder the tool is the run's own rig at that frame "
+        "(punch moved down by the stroke so far, and the die) and the ply thickness is the run's: "
+        "'jaxform wrinkles runs/a/frames_00010.vtu --out W' is enough.",
     )
-    p.add_argument("mesh", help="surface mesh file (the formed ply)")
-    p.add_argument("--tool", required=True,
-                   help="tool mesh file, or a preset: " + "; ".join(f"{k}: {v}" for k, v in PRESETS.items()))
-    p.add_argument("--ply-thickness-mm", type=float, required=True, help="ply thickness h, mm")
-    p.add_argument("--ply-index", type=int, default=1,
-                   help="position of the ply in the stack from the tool (d_crit = (i - 1/2) h)")
+    p.add_argument("mesh", help="surface mesh file (the formed ply), e.g. a frame of a 'jaxform run' folder")
+    p.add_argument("--tool", default=None,
+                   help="tool mesh file, a run folder, or a preset: "
+                   + "; ".join(f"{k}: {v}" for k, v in PRESETS.items())
+                   + ". Required unless MESH is a frame of a 'jaxform run' folder; given with such a "
+                   "frame it must agree with the run's rig (else --force)")
+    p.add_argument("--ply-thickness-mm", type=float, default=None,
+                   help="ply thickness h, mm (default: the run's, for a frame of a run; otherwise required)")
+    p.add_argument("--ply-index", type=int, default=None,
+                   help="position of the ply in the stack from the tool (d_crit = (i - 1/2) h; default 1); "
+                   "on a frame of a multi-ply run, the ply measured")
     p.add_argument("--kappa-threshold-per-m", type=float, default=100.0,
-                   help="curvature separating wrinkles from bridging, 1/m (default 100: radius 10 mm)")
+                   help="curvature separating wrinkles from bridging, 1/m, > 0 (default 100: radius 10 mm)")
     p.add_argument("--units", choices=("auto", "m", "mm"), default="auto",
                    help="units of the mesh file (auto: mm when it is more than 5 units across)")
     p.add_argument("--tool-units", choices=("auto", "m", "mm"), default="auto",
@@ -41,21 +77,57 @@ def add_parser(subparsers) -> None:
                    "DIR/section_<k>.csv (repeatable; write --section=-34,0,34,0 when it starts with -)")
     p.add_argument("--cloud", help="measured point cloud (PLY/XYZ/CSV) to compare with the mesh")
     p.add_argument("--cloud-units", choices=("auto", "m", "mm"), default="auto")
-    p.add_argument("--out", required=True, help="output directory")
-    p.add_argument("--force", action="store_true", help="write into a non-empty output directory")
+    p.add_argument("--out", required=True,
+                   help="output directory (a rerun into an earlier 'jaxform wrinkles' output replaces it)")
+    p.add_argument("--force", action="store_true",
+                   help="go on where the command would stop: write into a non-empty directory that is "
+                   "not a 'jaxform wrinkles' output, and measure although a check failed (mesh size vs "
+                   "--units, nodes inside the tool, tool far from the part, --tool or "
+                   "--ply-thickness-mm disagreeing with the run); each overridden check is printed and "
+                   "listed under 'forced' in summary.json")
     p.set_defaults(handler=run)
 
 
-def _parse_tool(spec: str, units: str):
-    """The tool as ``(vertices, faces)`` of a mesh file, or a tuple of :mod:`jaxform.tools` tools."""
-    from jaxform import tools
-    from jaxform.io.surface import read_surface
+# ---------------------------------------------------------------------------------------------
+# Tools: where they are
+# ---------------------------------------------------------------------------------------------
 
-    path = pathlib.Path(spec)
-    if path.exists():
-        v, f = read_surface(path, units=units, triangulate=True)
-        return (v, f), f"mesh {path} ({len(f)} triangles)"
+
+@dataclasses.dataclass
+class _Tool:
+    """A tool to measure against: analytic :mod:`jaxform.tools` each with its vertical
+    displacement ``dz`` (m), or a triangle mesh ``(vertices, faces)``."""
+
+    text: str
+    analytic: tuple = ()
+    dz: tuple = ()
+    mesh: tuple | None = None
+
+    def signed(self, nodes) -> np.ndarray | None:
+        """(N,) signed distance, m (negative inside a tool), or None for a mesh tool."""
+        if self.mesh is not None:
+            return None
+        from jaxform import tools
+
+        phi = [np.asarray(tools.sdf(t, nodes, dz)[0], dtype=np.float64) for t, dz in zip(self.analytic, self.dz)]
+        return np.min(np.stack(phi), axis=0)
+
+    def distance(self, nodes) -> np.ndarray:
+        """(N,) unsigned distance to the tool surface, m."""
+        if self.mesh is not None:
+            from jaxform import metrics as M
+
+            return np.asarray(M.tool_distance(nodes, *self.mesh, check=False), dtype=np.float64)
+        return np.abs(self.signed(nodes))
+
+
+def _parse_preset(spec: str):
+    """A preset tool spec as a :class:`_Tool`, or None when ``spec`` names no preset."""
+    from jaxform import tools
+
     name, _, rest = spec.partition(":")
+    if name not in ("hemisphere", "plane"):
+        return None
     params = {}
     for item in filter(None, rest.split(",")):
         key, sep, val = item.partition("=")
@@ -65,31 +137,162 @@ def _parse_tool(spec: str, units: str):
             params[key.strip()] = float(val)
         except ValueError:
             raise ValueError(f"tool parameter {key!r} must be a number, got {val!r}") from None
+        if not math.isfinite(params[key.strip()]):
+            raise ValueError(f"tool parameter {key!r} must be finite, got {val!r}")
     if name == "hemisphere":
         allowed = {"radius_mm", "x_mm", "y_mm", "z_mm", "base"}
         bad = set(params) - allowed
         if bad:
             raise ValueError(f"unknown hemisphere parameters {sorted(bad)}; allowed: {sorted(allowed)}")
         radius_mm = params.get("radius_mm", 50.0)
+        if not radius_mm > 0:
+            raise ValueError(f"hemisphere radius_mm must be > 0, got {radius_mm:g}")
         rig = tools.hemisphere_rig(radius_mm * 1e-3,
                                    tuple(params.get(k, 0.0) * 1e-3 for k in ("x_mm", "y_mm", "z_mm")),
                                    base_plane=bool(params.get("base", 1.0)))
-        return rig, f"hemisphere rig, punch radius {radius_mm:g} mm"
-    if name == "plane":
-        bad = set(params) - {"z_mm"}
-        if bad:
-            raise ValueError(f"unknown plane parameters {sorted(bad)}; allowed: ['z_mm']")
-        return (tools.Plane(point=(0.0, 0.0, params.get("z_mm", 0.0) * 1e-3)),), "plane"
-    raise ValueError(f"--tool {spec!r} is neither an existing file nor a preset "
-                     f"({', '.join(PRESETS)})")
+        return _Tool(f"hemisphere rig (apex up), punch radius {radius_mm:g} mm", rig, (0.0,) * len(rig))
+    bad = set(params) - {"z_mm"}
+    if bad:
+        raise ValueError(f"unknown plane parameters {sorted(bad)}; allowed: ['z_mm']")
+    return _Tool("plane", (tools.Plane(point=(0.0, 0.0, params.get("z_mm", 0.0) * 1e-3)),), (0.0,))
+
+
+@dataclasses.dataclass
+class _Run:
+    """A ``jaxform run`` folder: its case, summary and frame times."""
+
+    folder: pathlib.Path
+    case: object
+    summary: dict
+    frames: dict  # file name -> time, s
+
+
+def _is_run_folder(folder: pathlib.Path) -> bool:
+    return folder.is_dir() and (folder / "summary.json").is_file() and (folder / "frames.pvd").is_file()
+
+
+def _run_of_frame(mesh: pathlib.Path) -> pathlib.Path | None:
+    """The run folder ``mesh`` is a frame of, or None."""
+    if _FRAME.search(mesh.name) and _is_run_folder(mesh.parent):
+        return mesh.parent
+    return None
+
+
+def _load_run(folder: pathlib.Path) -> _Run:
+    from jaxform.forming.case import from_dict
+
+    try:
+        summary = json.loads((folder / "summary.json").read_text())
+    except (OSError, ValueError) as err:
+        raise ValueError(f"{folder / 'summary.json'} is not readable JSON ({err}); is {folder} a 'jaxform run' "
+                         "folder? Give --tool and --ply-thickness-mm explicitly") from None
+    if not isinstance(summary, dict) or not isinstance(summary.get("inputs"), dict):
+        raise ValueError(f"{folder / 'summary.json'} has no 'inputs' (the case the run used): the rig cannot be "
+                         "rebuilt; give --tool and --ply-thickness-mm explicitly")
+    try:
+        case = from_dict(summary["inputs"])
+    except ValueError as err:
+        raise ValueError(f"{folder / 'summary.json'}: its 'inputs' are not a valid case ({err})") from None
+    frames = {}
+    try:
+        for ds in ET.parse(folder / "frames.pvd").getroot().iter("DataSet"):
+            frames[ds.get("file")] = float(ds.get("timestep"))
+    except (ET.ParseError, TypeError, ValueError) as err:
+        raise ValueError(f"{folder / 'frames.pvd'} is not a readable frame index ({err})") from None
+    return _Run(folder, case, summary, frames)
+
+
+def _run_tool(run: _Run, mesh: pathlib.Path):
+    """The rig of ``run`` posed at the time of frame ``mesh`` (the run's last frame when ``mesh`` is
+    not one of its frames): ``(tool, rig_facts)``."""
+    from jaxform import tools
+    from jaxform.forming.rig import build_tools
+
+    same = mesh.parent.resolve() == run.folder.resolve() and mesh.name in run.frames
+    if same:
+        t, when = run.frames[mesh.name], f"frame {mesh.name}"
+    elif run.frames:
+        name = max(run.frames, key=run.frames.get)
+        t, when = run.frames[name], f"the run's last frame {name} ({mesh} is not a frame of it)"
+    else:
+        raise ValueError(f"{run.folder / 'frames.pvd'} lists no frame: the run wrote nothing to measure against")
+    rig = build_tools(run.case)
+    hist = run.summary.get("history") or {}
+    ts, us = hist.get("t_s"), hist.get("punch_displacement_m")
+    if ts and us and len(ts) == len(us):
+        down = float(np.interp(t, np.asarray(ts, float), np.asarray(us, float)))  # what the run did
+        source = "history.punch_displacement_m"
+    else:
+        down = -float(tools.displacement(rig.punch, t))
+        source = "the case's punch motion"
+    facts = {"run": str(run.folder), "case": getattr(run.case, "name", None), "frame": when, "time_s": t,
+             "punch_displacement_m": down, "punch_displacement_from": source,
+             "tools": ["punch", "die"], "holder": "left out (as the run's deviation_m)"}
+    text = (f"the rig of run {run.folder} at {when}, t = {t:.6g} s: punch moved down {down * 1e3:.4g} mm, die "
+            "(holder left out)")
+    return _Tool(text, (rig.punch, rig.die), (-down, 0.0)), facts
+
+
+def _read_checked(reader, path, units, force, forced, **kw):
+    """``reader(path, units=..., on_units_mismatch='raise')``; with ``force`` a units mismatch is
+    recorded in ``forced`` and the file read as told."""
+    try:
+        return reader(path, units=units, on_units_mismatch="raise", **kw)
+    except ValueError as err:
+        if "units=" not in str(err):
+            raise
+        msg = f"{err} (use --units/--tool-units/--cloud-units m or mm, or auto)"
+        if not force:
+            raise ValueError(msg + "; --force measures anyway") from None
+        forced.append(msg)
+        return reader(path, units=units, on_units_mismatch="ignore", **kw)
+
+
+# ---------------------------------------------------------------------------------------------
+# Arguments, checked before any work
+# ---------------------------------------------------------------------------------------------
+
+
+def _parse_sections(texts) -> list:
+    """``[(text, (x1, y1), (x2, y2))]`` in m; ValueError for anything but four finite numbers of a
+    section of non-zero length."""
+    out = []
+    for text in texts:
+        try:
+            vals = [float(t) for t in text.split(",")]
+        except ValueError:
+            vals = []
+        if len(vals) != 4 or not all(math.isfinite(v) for v in vals):
+            raise ValueError(f"--section {text!r}: expected four numbers X1,Y1,X2,Y2 in mm "
+                             "(write --section=-34,0,34,0 when it starts with -)")
+        x1, y1, x2, y2 = (v * 1e-3 for v in vals)
+        if x1 == x2 and y1 == y2:
+            raise ValueError(f"--section {text!r}: its two ends are the same point")
+        out.append((text, (x1, y1), (x2, y2)))
+    return out
+
+
+def _check_args(args) -> None:
+    for name, val in (("--ply-thickness-mm", args.ply_thickness_mm), ("--kappa-threshold-per-m", args.kappa_threshold_per_m)):
+        if val is not None and not (math.isfinite(val) and val > 0):
+            raise ValueError(f"{name} must be a positive number, got {val:g}")
+    if args.ply_index is not None and args.ply_index < 1:
+        raise ValueError(f"--ply-index counts from 1 (the ply on the tool), got {args.ply_index}")
+    if args.cloud and not pathlib.Path(args.cloud).exists():
+        raise FileNotFoundError(f"no such point-cloud file: {args.cloud}")
 
 
 def _check_out(out: pathlib.Path, force: bool) -> None:
+    """Refuse now (before any work) what :func:`jaxform.io.output.prepare_output_dir` would refuse."""
+    from jaxform.io.output import MARKER
+
     if out.exists() and not out.is_dir():
-        raise FileExistsError(f"--out {out} exists and is not a directory")
-    if out.exists() and any(out.iterdir()) and not force:
-        raise FileExistsError(f"--out {out} is not empty; pass --force to write into it")
-    out.mkdir(parents=True, exist_ok=True)
+        raise FileExistsError(f"output path {out} exists and is a file; choose a directory")
+    if out.is_dir() and any(out.iterdir()) and not force:
+        marker = out / MARKER
+        if not (marker.exists() and marker.read_text().strip() == "wrinkles"):
+            raise FileExistsError(f"output directory {out} is not empty and was not written by 'jaxform wrinkles'; "
+                                  "choose another directory or pass --force to write into it")
 
 
 def _stats(values: np.ndarray) -> dict:
@@ -99,39 +302,154 @@ def _stats(values: np.ndarray) -> dict:
             "max": float(v.max()), "rms": float(np.sqrt(np.mean(v * v)))}
 
 
-def run(args) -> int:
-    import jax.numpy as jnp
+def _select_ply(nodes, faces, data, ply: int, n_plies: int, path):
+    """The nodes and faces of ply ``ply`` of a multi-ply frame (by its ``ply_id`` point data)."""
+    pid = data.get("ply_id")
+    if pid is None:
+        raise ValueError(f"{path} has no 'ply_id' point data to pick ply {ply} of the {n_plies}-ply run from")
+    pid = np.asarray(pid).reshape(-1)
+    keep = pid[faces].min(axis=1) == ply
+    keep &= pid[faces].max(axis=1) == ply
+    if not keep.any():
+        raise ValueError(f"{path}: no face of ply {ply} (ply_id)")
+    f = faces[keep]
+    used = np.unique(f)
+    remap = -np.ones(len(nodes), np.int64)
+    remap[used] = np.arange(len(used))
+    return nodes[used], remap[f]
 
+
+# ---------------------------------------------------------------------------------------------
+# The command
+# ---------------------------------------------------------------------------------------------
+
+
+def run(args) -> int:
     from jaxform import metrics as M
     from jaxform.geometry import quads_to_triangles
+    from jaxform.io.output import prepare_output_dir
     from jaxform.io.surface import read_point_cloud, read_surface, write_vtu
     from jaxform.plots import wrinkles as P
 
     t0 = time.perf_counter()
-    if not args.ply_thickness_mm > 0:
-        raise ValueError(f"--ply-thickness-mm must be positive, got {args.ply_thickness_mm}")
-    if args.ply_index < 1:
-        raise ValueError(f"--ply-index counts from 1 (the ply on the tool), got {args.ply_index}")
+    # 1. every argument, before any work or any file written
+    _check_args(args)
+    sections = _parse_sections(args.section)
     out = pathlib.Path(args.out)
-    nodes, faces = read_surface(args.mesh, units=args.units)
-    tool, tool_text = _parse_tool(args.tool, args.tool_units)
     _check_out(out, args.force)
+    mesh_path = pathlib.Path(args.mesh)
+    if not mesh_path.exists():
+        raise FileNotFoundError(f"no such mesh file: {mesh_path}")
+    forced: list[str] = []
 
-    if isinstance(tool[0], np.ndarray):  # a mesh file: (vertices, faces)
-        tv, tf = tool
-        span_m = np.linalg.norm(np.ptp(nodes, axis=0))
-        span_t = np.linalg.norm(np.ptp(tv, axis=0))
-        if span_m > 0 and span_t > 0 and not (1e-2 < span_t / span_m < 1e2):
-            raise ValueError(
-                f"the mesh is {span_m:.4g} m across and the tool {span_t:.4g} m: mixed units? "
-                "set --units and --tool-units (m or mm) explicitly")
-        dist = np.asarray(M.tool_distance(nodes, tv, tf))
+    # 2. the run the mesh comes from, if any, and the tool
+    spec = args.tool
+    frame_of = _run_of_frame(mesh_path)
+    run_dir = None
+    if spec == "run":
+        if frame_of is None:
+            raise ValueError(f"--tool run: {mesh_path} is not a frame of a 'jaxform run' folder (frames_#####.vtu "
+                             "beside frames.pvd and summary.json); give the run folder: --tool RUN_DIR")
+        run_dir = frame_of
+    elif spec is not None and pathlib.Path(spec).is_dir():
+        if not _is_run_folder(pathlib.Path(spec)):
+            raise ValueError(f"--tool {spec}: a directory but not a 'jaxform run' folder (no summary.json and "
+                             "frames.pvd)")
+        run_dir = pathlib.Path(spec)
+    elif spec is None:
+        if frame_of is None:
+            raise ValueError(f"--tool is required: {mesh_path} is not a frame of a 'jaxform run' folder, so the "
+                             "tool is unknown (a mesh file, a run folder, or a preset: " + ", ".join(PRESETS) + ")")
+        run_dir = frame_of
+    if run_dir is not None:
+        run = _load_run(run_dir)
+    elif frame_of is not None:  # --tool given for a frame of a run: its rig is the reference, if readable
+        try:
+            run = _load_run(frame_of)
+        except ValueError:
+            run, frame_of = None, None
     else:
-        dist = np.asarray(M.tool_distance(nodes, tool))
+        run = None
+    case = run.case if run is not None else None
+    preset = None
+    if run_dir is None:
+        preset = _parse_preset(spec)
+        if preset is None and not pathlib.Path(spec).is_file():
+            raise ValueError(f"--tool {spec!r} is neither an existing file nor a preset ({', '.join(PRESETS)}) "
+                             "nor a 'jaxform run' folder")
+
+    h_run = float(case.ply_thickness) if case is not None else None
+    if args.ply_thickness_mm is None and h_run is None:
+        raise ValueError("--ply-thickness-mm is required (the ply thickness h, mm) when MESH is not a frame of a "
+                         "'jaxform run' folder")
+    h = args.ply_thickness_mm * 1e-3 if args.ply_thickness_mm is not None else h_run
+    if h_run is not None and not math.isclose(h, h_run, rel_tol=1e-6):
+        msg = (f"--ply-thickness-mm {args.ply_thickness_mm:g} but the run {run.folder} formed plies "
+               f"{h_run * 1e3:g} mm thick; leave it out to use the run's")
+        if not args.force:
+            raise ValueError(msg + ", or pass --force to measure with yours")
+        forced.append(msg)
+    n_plies = case.n_plies if case is not None else 1
+    ply = args.ply_index or 1
+    if case is not None and ply > n_plies:
+        raise ValueError(f"--ply-index {ply}: the run {run.folder} has {n_plies} ply(ies)")
+
+    # 3. read everything (files are checked; nothing written yet)
+    units = args.units
+    if frame_of is not None and units == "auto":
+        units = "m"  # jaxform writes metres
+    nodes, faces, data = _read_checked(read_surface, mesh_path, units, args.force, forced, point_data=True)
+    if n_plies > 1 and "ply_id" in data:  # a frame of a stack: the ply measured
+        nodes, faces = _select_ply(nodes, faces, data, ply, n_plies, mesh_path)
+    rig_facts = None
+    if run_dir is not None:
+        tool, rig_facts = _run_tool(run, mesh_path)
+    else:
+        tool = preset
+        if tool is None:
+            tool_path = pathlib.Path(spec)
+            tv, tf = _read_checked(read_surface, tool_path, args.tool_units, args.force, forced, triangulate=True)
+            tool = _Tool(f"mesh {tool_path} ({len(tf)} triangles)", mesh=(tv, tf))
+            span_m = np.linalg.norm(np.ptp(nodes, axis=0))
+            span_t = np.linalg.norm(np.ptp(tv, axis=0))
+            if span_m > 0 and span_t > 0 and not (1e-2 < span_t / span_m < 1e2):
+                msg = (f"the mesh is {span_m:.4g} m across and the tool {span_t:.4g} m: mixed units? "
+                       "set --units and --tool-units (m or mm) explicitly")
+                if not args.force:
+                    raise ValueError(msg + ", or pass --force to measure anyway")
+                forced.append(msg)
+    cloud = _read_checked(read_point_cloud, args.cloud, args.cloud_units, args.force, forced) if args.cloud else None
+
+    # 4. the measurement, and the checks that it is a measurement of this part on this tool
+    dcrit = float(M.d_crit(h, ply))
+    phi = tool.signed(nodes)
+    dist = np.abs(phi) if phi is not None else tool.distance(nodes)
+    problems = []
+    if frame_of is not None and run_dir is None:  # --tool given for a frame of a run: must agree with its rig
+        rig_tool, _ = _run_tool(run, mesh_path)
+        gap = np.abs(dist - rig_tool.distance(nodes))
+        if gap.max() > max(1e-3, h):
+            problems.append(f"--tool {spec} disagrees with the rig {frame_of} was formed on by up to "
+                            f"{gap.max() * 1e3:.3g} mm; leave --tool out (or --tool run) to measure against the "
+                            f"run's own rig ({rig_tool.text})")
+    tol = max(0.5 * h, 1e-4)
+    if phi is not None and (phi < -tol).any():
+        inside = phi < -tol
+        problems.append(f"{int(inside.sum())} of {len(nodes)} nodes are inside the tool ({tool.text}), up to "
+                        f"{-phi.min() * 1e3:.3g} mm deep: the mesh is not where the tool is (wrong tool, pose, "
+                        "offset or --units?)")
+    span = float(np.linalg.norm(np.ptp(nodes, axis=0)))
+    far = max(10.0 * dcrit, 0.05 * span)
+    if dist.min() > far:
+        problems.append(f"the closest node is {dist.min() * 1e3:.4g} mm from the tool ({tool.text}), more than "
+                        f"{far * 1e3:.3g} mm: the part was not formed on this tool here (wrong tool, pose, offset "
+                        "or --units?)")
+    if problems and not args.force:
+        raise ValueError("; ".join(problems) + ". Pass --force to measure anyway")
+    forced += problems
+
     k1, k2 = (np.asarray(k) for k in M.principal_curvatures(nodes, faces))
     km = np.maximum(np.abs(k1), np.abs(k2))
-    h = args.ply_thickness_mm * 1e-3
-    dcrit = float(M.d_crit(h, args.ply_index))
     labels = np.asarray(M.classify_zones(dist, km, dcrit, kappa_threshold=args.kappa_threshold_per_m,
                                          faces=faces))
     areas = np.asarray(M.node_areas(nodes, faces))
@@ -139,24 +457,18 @@ def run(args) -> int:
     count, region = M.count_wrinkle_regions(labels, faces, areas, min_area=4.0 * np.median(areas))
     radius = np.asarray(M.wrinkle_radius(km))
     amp = np.where(labels == M.WRINKLE, dist, 0.0)
+    profiles = []
+    for text, a, b in sections:
+        s, val, valid, height = (np.asarray(x) for x in M.section_profile(nodes, faces, dist, a, b, 400))
+        profiles.append((text, s, val, valid, height))
+    cd = None
+    if cloud is not None:
+        cd = np.asarray(M.tool_distance(cloud, nodes, np.asarray(quads_to_triangles(faces)), check=False))
 
-    written = []
-    written.append(write_vtu(out / "wrinkles.vtu", nodes, faces, point_data={
-        "distance_m": dist, "k1_per_m": k1, "k2_per_m": k2, "kappa_max_per_m": km,
-        "wrinkle_radius_m": radius, "zone": labels.astype(np.int32),
-        "wrinkle_region": np.asarray(region), "node_area_m2": areas}))
-    written.append(P.plot_node_field(out / "distance.png", nodes, faces, dist, scale=1e3,
-                                     title="Distance to the tool", label="d (mm)"))
-    written.append(P.plot_node_field(out / "kappa_max.png", nodes, faces, km, cmap="magma",
-                                     title="kappa_max", label="kappa_max (1/m)",
-                                     vmax=float(np.percentile(km, 99.5))))
-    written.append(P.plot_zones(out / "zones.png", nodes, faces, labels,
-                                title=f"Zones (d_crit {dcrit * 1e3:g} mm, "
-                                f"kappa >= {args.kappa_threshold_per_m:g} 1/m)"))
     defect = labels != M.CONFORMING
     summary = {
-        "mesh": str(args.mesh), "tool": tool_text, "n_nodes": int(len(nodes)),
-        "n_faces": int(len(faces)), "ply_thickness_m": h, "ply_index": args.ply_index,
+        "mesh": str(args.mesh), "tool": tool.text, "n_nodes": int(len(nodes)),
+        "n_faces": int(len(faces)), "ply_thickness_m": h, "ply_index": ply,
         "d_crit_m": dcrit, "kappa_threshold_per_m": args.kappa_threshold_per_m,
         "zone_area_m2": {"conforming": float(zarea[0]), "bridging": float(zarea[1]),
                          "wrinkle": float(zarea[2])},
@@ -166,29 +478,39 @@ def run(args) -> int:
         "distance_m": _stats(dist),
         "kappa_max_per_m": _stats(km),
         "kappa_max_defect_per_m": _stats(km[defect]) if defect.any() else None,
+        "forced": forced,
     }
-    sections = []
-    for k, text in enumerate(args.section):
-        try:
-            x1, y1, x2, y2 = (float(t) * 1e-3 for t in text.split(","))
-        except ValueError:
-            raise ValueError(f"--section {text!r}: expected X1,Y1,X2,Y2 in mm") from None
-        s, val, valid, height = (np.asarray(a) for a in M.section_profile(
-            nodes, faces, dist, (x1, y1), (x2, y2), 400))
+    if rig_facts is not None:
+        summary["rig"] = rig_facts
+
+    # 5. write (only now)
+    out = prepare_output_dir(out, force=args.force, owner="wrinkles", replaces=OUTPUTS)
+    written = [write_vtu(out / "wrinkles.vtu", nodes, faces, point_data={
+        "distance_m": dist, "k1_per_m": k1, "k2_per_m": k2, "kappa_max_per_m": km,
+        "wrinkle_radius_m": radius, "zone": labels.astype(np.int32),
+        "wrinkle_region": np.asarray(region), "node_area_m2": areas})]
+    written.append(P.plot_node_field(out / "distance.png", nodes, faces, dist, scale=1e3,
+                                     title="Distance to the tool", label="d (mm)"))
+    written.append(P.plot_node_field(out / "kappa_max.png", nodes, faces, km, cmap="magma",
+                                     title="kappa_max", label="kappa_max (1/m)",
+                                     vmax=float(np.percentile(km, 99.5))))
+    written.append(P.plot_zones(out / "zones.png", nodes, faces, labels,
+                                title=f"Zones (d_crit {dcrit * 1e3:g} mm, "
+                                f"kappa >= {args.kappa_threshold_per_m:g} 1/m)"))
+    rows = []
+    for k, (text, s, val, valid, height) in enumerate(profiles):
         path = out / f"section_{k}.csv"
         with open(path, "w") as fh:
             fh.write("s_mm,amplitude_mm,height_mm,valid\n")
             for row in zip(s * 1e3, val * 1e3, height * 1e3, valid.astype(int)):
                 fh.write("{:.6f},{:.6f},{:.6f},{:d}\n".format(*row))
         written.append(path)
-        sections.append({"points_mm": text, "file": path.name,
-                         "wrinkle_count": int(M.count_section_wrinkles(val, valid, min_amplitude=dcrit)),
-                         "max_amplitude_m": float(val[valid].max()) if valid.any() else None})
-    if sections:
-        summary["sections"] = sections
-    if args.cloud:
-        cloud = read_point_cloud(args.cloud, units=args.cloud_units)
-        cd = np.asarray(M.tool_distance(cloud, nodes, np.asarray(quads_to_triangles(faces))))
+        rows.append({"points_mm": text, "file": path.name,
+                     "wrinkle_count": int(M.count_section_wrinkles(val, valid, min_amplitude=dcrit)),
+                     "max_amplitude_m": float(val[valid].max()) if valid.any() else None})
+    if rows:
+        summary["sections"] = rows
+    if cloud is not None:
         written.append(write_vtu(out / "cloud_distance.vtu", cloud, None,
                                  point_data={"distance_to_surface_m": cd}))
         written.append(P.plot_node_field(out / "cloud_distance.png", cloud, None, cd, scale=1e3,
@@ -198,10 +520,12 @@ def run(args) -> int:
     summary["wall_time_s"] = time.perf_counter() - t0
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     written.append(out / "summary.json")
+    for msg in forced:
+        print(f"jaxform wrinkles: warning (--force): {msg}", file=sys.stderr)
+    print(f"jaxform wrinkles: tool: {tool.text}")
     print(f"jaxform wrinkles: {summary['wrinkle_count']} wrinkle region(s), wrinkle area "
           f"{zarea[2] * 1e6:.1f} mm^2, bridging {zarea[1] * 1e6:.1f} mm^2, max amplitude "
           f"{summary['max_wrinkle_amplitude_m'] * 1e3:.3f} mm")
     for p in written:
         print(f"  wrote {p}")
-    del jnp
     return 0

@@ -1,5 +1,6 @@
 """``jaxform wrinkles`` end to end on files, including bad input."""
 import json
+import re
 
 import meshio
 import numpy as np
@@ -130,3 +131,162 @@ def test_read_surface_formats_and_units(tmp_path):
     write_vtu(tmp_path / "cloud.vtu", pts * 1e-3, None, point_data={"d": np.arange(6.0)})
     meshio.write(tmp_path / "c.ply", meshio.Mesh(pts * 1e-3, []))
     assert read_point_cloud(tmp_path / "c.ply").shape == (6, 3)
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 14 item 2: on jaxform's own output the tool is the run's rig, where it was at that frame
+# ---------------------------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def small_run(tmp_path_factory):
+    """A 4 mm stroke of case A (25 mm elements, 3 frames): frames_00002.vtu is the last."""
+    out = tmp_path_factory.mktemp("run") / "a"
+    assert main(["run", "case-a-woven-nlbm", "--out", str(out), "--element-size-mm", "25",
+                 "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
+    return out
+
+
+def test_frame_of_a_run_is_measured_on_its_own_rig(small_run, tmp_path, capsys):
+    frame = small_run / "frames_00002.vtu"
+    run_summary = json.loads((small_run / "summary.json").read_text())
+    h = 0.3e-3  # woven 38616
+    # The README workflow: no --tool, no --ply-thickness-mm.
+    out = tmp_path / "w"
+    assert main(["wrinkles", str(frame), "--out", str(out)]) == 0
+    assert "the rig of run" in capsys.readouterr().out
+    s = json.loads((out / "summary.json").read_text())
+    assert s["ply_thickness_m"] == pytest.approx(h) and s["d_crit_m"] == pytest.approx(h / 2)
+    assert s["rig"]["punch_displacement_m"] == pytest.approx(4e-3, rel=1e-5)
+    assert s["rig"]["time_s"] == run_summary["frame_times_s"][-1] and s["forced"] == []
+    # Independent check: the run's own deviation_m (ply face to punch/die) is d - h/2.
+    dev = meshio.read(frame).point_data["deviation_m"]
+    d = meshio.read(out / "wrinkles.vtu").point_data["distance_m"]
+    err = np.abs(d - h / 2 - dev).max()
+    assert err < 1e-6, err  # 7.5e-9 m on this run (float32 frames)
+    assert dev.max() > 3e-3  # the part does leave the tools (a real check, not all zeros)
+    # Explicit --tool run, the run folder, and the run's thickness given again: the same numbers.
+    for extra in (["--tool", "run"], ["--tool", str(small_run), "--ply-thickness-mm", "0.3"]):
+        assert main(["wrinkles", str(frame), "--out", str(out)] + extra) == 0
+        np.testing.assert_array_equal(meshio.read(out / "wrinkles.vtu").point_data["distance_m"], d)
+    # A copy of the frame elsewhere with --tool RUN_DIR: the punch at the run's last frame.
+    copy = tmp_path / "part.vtu"
+    copy.write_bytes(frame.read_bytes())
+    assert main(["wrinkles", str(copy), "--tool", str(small_run), "--out", str(out)]) == 0
+    np.testing.assert_array_equal(meshio.read(out / "wrinkles.vtu").point_data["distance_m"], d)
+    # The first frame: the flat ply on the die (d = h/2: conforming, though float32 puts it ~1e-8 m
+    # higher), the punch apex on it, bridging over the die opening.
+    first = small_run / "frames_00000.vtu"
+    assert main(["wrinkles", str(first), "--out", str(out)]) == 0
+    m = meshio.read(out / "wrinkles.vtu")
+    d0, zone = m.point_data["distance_m"], m.point_data["zone"]
+    np.testing.assert_allclose(d0 - h / 2, meshio.read(first).point_data["deviation_m"], atol=1e-6)
+    on_die = np.hypot(m.points[:, 0], m.points[:, 1]) > 0.053 + 0.006
+    assert on_die.sum() > 50 and np.all(zone[on_die] == 0)
+    assert np.all(zone[d0 > h] == 1)
+
+
+def test_a_frame_with_a_tool_that_is_not_its_rig(small_run, tmp_path, capsys):
+    frame = small_run / "frames_00002.vtu"
+    out = tmp_path / "w"
+    # The original problem: the hemisphere preset (apex up at z = 0) is not the run's punch (apex
+    # down, on the stack, moved down by the stroke). It used to measure tens of mm with exit 0.
+    args = ["wrinkles", str(frame), "--tool", "hemisphere", "--ply-thickness-mm", "0.3", "--out", str(out)]
+    assert main(args) == 2
+    err = capsys.readouterr().err
+    assert "disagrees with the rig" in err and "inside the tool" in err and "--force" in err
+    assert not out.exists()  # nothing written
+    assert main(args + ["--force"]) == 0
+    assert "warning (--force)" in capsys.readouterr().err
+    s = json.loads((out / "summary.json").read_text())
+    assert len(s["forced"]) == 2
+    d = meshio.read(out / "wrinkles.vtu").point_data["distance_m"]
+    dev = meshio.read(frame).point_data["deviation_m"]
+    assert np.abs(d - 0.15e-3 - dev).max() > 0.03  # what the preset measures on this part
+    # A ply thickness other than the run's; a ply the run does not have; --tool run elsewhere.
+    assert main(["wrinkles", str(frame), "--ply-thickness-mm", "0.5", "--out", str(out)]) == 2
+    assert "0.3 mm thick" in capsys.readouterr().err
+    assert main(["wrinkles", str(frame), "--ply-index", "2", "--out", str(out)]) == 2
+    assert "has 1 ply" in capsys.readouterr().err
+    copy = tmp_path / "part.vtu"
+    copy.write_bytes(frame.read_bytes())
+    assert main(["wrinkles", str(copy), "--tool", "run", "--out", str(out)]) == 2
+    assert "not a frame of a 'jaxform run' folder" in capsys.readouterr().err
+    assert main(["wrinkles", str(copy), "--out", str(out)]) == 2  # no run: the tool is required
+    assert "--tool is required" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------------------------------------
+# Issue 14 item 7: no plausible wrong answer with exit 0
+# ---------------------------------------------------------------------------------------------
+
+
+def test_geometry_that_cannot_be_right_is_refused(sheet_mm, tmp_path, capsys):
+    path, x, f, _ = sheet_mm
+    out = tmp_path / "o"
+    base = ["wrinkles", str(path), "--ply-thickness-mm", "0.3", "--out", str(out)]
+    cases = {
+        "probably in mm": ["--tool", "hemisphere", "--units", "m"],  # a mm file read as m
+        "more than": ["--tool", "plane:z_mm=10000"],  # a tool 10 m away
+        "inside the tool": ["--tool", "hemisphere:z_mm=5"],  # the part 5 mm inside the dome
+    }
+    for said, extra in cases.items():
+        assert main(base + extra) == 2, said
+        err = capsys.readouterr().err
+        assert said in err and "--force" in err, err
+        assert not out.exists()
+        assert main(base + extra + ["--force"]) == 0  # --force measures anyway, and says so
+        assert json.loads((out / "summary.json").read_text())["forced"]
+        assert "warning (--force)" in capsys.readouterr().err
+        for p in out.iterdir():
+            p.unlink()
+        out.rmdir()
+
+
+def test_arguments_are_checked_before_any_work(sheet_mm, tmp_path, capsys):
+    path, x, f, _ = sheet_mm
+    out = tmp_path / "o"
+    base = ["wrinkles", str(path), "--tool", "hemisphere", "--out", str(out)]
+    bad = {
+        "--kappa-threshold-per-m": (["--ply-thickness-mm", "0.3", "--kappa-threshold-per-m", "-5"],
+                                    ["--ply-thickness-mm", "0.3", "--kappa-threshold-per-m", "0"]),
+        "--ply-thickness-mm": (["--ply-thickness-mm", "0"], ["--ply-thickness-mm", "-0.3"],
+                               ["--ply-thickness-mm", "nan"]),
+        "--ply-index": (["--ply-thickness-mm", "0.3", "--ply-index", "0"],),
+        "--section": (["--ply-thickness-mm", "0.3", "--section", "1,2,3"],
+                      ["--ply-thickness-mm", "0.3", "--section=-34,0,34,0", "--section", "a,0,1,0"],
+                      ["--ply-thickness-mm", "0.3", "--section", "5,5,5,5"]),
+        "no such point-cloud": (["--ply-thickness-mm", "0.3", "--cloud", str(tmp_path / "none.csv")],),
+    }
+    for said, variants in bad.items():
+        for extra in variants:
+            assert main(base + extra) == 2, extra
+            assert said in capsys.readouterr().err
+            assert not out.exists(), extra  # nothing written, nothing to block the rerun
+    assert main(base + ["--ply-thickness-mm", "0.3", "--section=-34,0,34,0", "--section=0,-34,0,34"]) == 0
+    assert (out / "section_1.csv").exists()
+    # A rerun into its own folder replaces what the first one wrote (no stale section_1.csv).
+    assert main(base + ["--ply-thickness-mm", "0.3", "--section=-34,0,34,0"]) == 0
+    assert (out / "section_0.csv").exists() and not (out / "section_1.csv").exists()
+
+
+def test_empty_and_cellless_meshes_are_named(tmp_path, capsys):
+    out = tmp_path / "o"
+    files = {}
+    files["empty.vtu"] = b""
+    files["garbage.vtu"] = b"not xml at all"  # meshio calls sys.exit on this one
+    files["nothing.stl"] = b"solid x\nendsolid x\n"
+    files["points.obj"] = b"v 0 0 0\nv 1 0 0\nv 0 1 0\n"
+    meshio.write(tmp_path / "lines.vtu", meshio.Mesh(np.eye(3), [("line", np.array([[0, 1], [1, 2]]))]))
+    files["lines.vtu"] = (tmp_path / "lines.vtu").read_bytes()
+    said = {"empty.vtu": "is empty (0 bytes)", "garbage.vtu": "could not read",
+            "nothing.stl": "has no points", "points.obj": "no cells", "lines.vtu": "no surface cells"}
+    for name, content in files.items():
+        p = tmp_path / name
+        p.write_bytes(content)
+        assert main(["wrinkles", str(p), "--tool", "plane", "--ply-thickness-mm", "0.3", "--out", str(out)]) == 2
+        err = capsys.readouterr().err
+        assert err.startswith("jaxform wrinkles: error:") and str(p) in err and said[name] in err, err
+        with pytest.raises(ValueError, match=re.escape(said[name])):
+            read_surface(p)
+    assert not out.exists()

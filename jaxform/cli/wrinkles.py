@@ -39,6 +39,10 @@ OUTPUTS = ("wrinkles.vtu", "summary.json", "distance.png", "kappa_max.png", "zon
            "cloud_distance.vtu", "cloud_distance.png")
 """What the command writes into its folder (a rerun replaces all of it)."""
 
+DEFECT_TOLERANCE = 0.02
+"""A node is a defect where ``d > d_crit + 0.02 h``: a ply lying on the tool is not one for the
+rounding of its coordinates (float32 frames put a flat ply ~1e-8 m above h/2); no wrinkle is 6 um."""
+
 _FRAME = re.compile(r"frames_(\d+)\.vtu$")
 
 
@@ -233,19 +237,43 @@ def _run_tool(run: _Run, mesh: pathlib.Path):
     return _Tool(text, (rig.punch, rig.die), (-down, 0.0)), facts
 
 
-def _read_checked(reader, path, units, force, forced, **kw):
-    """``reader(path, units=..., on_units_mismatch='raise')``; with ``force`` a units mismatch is
-    recorded in ``forced`` and the file read as told."""
+def _read_checked(reader, path, units, problems, **kw):
+    """``reader(path, units=...)``; a size at odds with ``units`` goes to ``problems``."""
     try:
         return reader(path, units=units, on_units_mismatch="raise", **kw)
     except ValueError as err:
         if "units=" not in str(err):
             raise
-        msg = f"{err} (use --units/--tool-units/--cloud-units m or mm, or auto)"
-        if not force:
-            raise ValueError(msg + "; --force measures anyway") from None
-        forced.append(msg)
+        problems.append(f"{err} (use --units/--tool-units/--cloud-units m or mm, or auto)")
         return reader(path, units=units, on_units_mismatch="ignore", **kw)
+
+
+def _where_the_tool_is(spec, mesh_path: pathlib.Path):
+    """``(run, run_dir, preset)``: the run whose rig is the tool (``run_dir``), or the run ``mesh_path``
+    is a frame of (then ``--tool`` is checked against its rig), and the preset tool, if any."""
+    frame_of = _run_of_frame(mesh_path)
+    run_dir = frame_of if spec in (None, "run") else None
+    if spec == "run" and frame_of is None:
+        raise ValueError(f"--tool run: {mesh_path} is not a frame of a 'jaxform run' folder (frames_#####.vtu "
+                         "beside frames.pvd and summary.json); give the run folder: --tool RUN_DIR")
+    if spec is None and frame_of is None:
+        raise ValueError(f"--tool is required: {mesh_path} is not a frame of a 'jaxform run' folder, so the "
+                         "tool is unknown (a mesh file, a run folder, or a preset: " + ", ".join(PRESETS) + ")")
+    if spec not in (None, "run") and pathlib.Path(spec).is_dir():
+        if not _is_run_folder(pathlib.Path(spec)):
+            raise ValueError(f"--tool {spec}: a directory but not a 'jaxform run' folder (no summary.json and "
+                             "frames.pvd)")
+        run_dir = pathlib.Path(spec)
+    if run_dir is not None:
+        return _load_run(run_dir), run_dir, None
+    preset = _parse_preset(spec)
+    if preset is None and not pathlib.Path(spec).is_file():
+        raise ValueError(f"--tool {spec!r} is neither an existing file nor a preset ({', '.join(PRESETS)}) "
+                         "nor a 'jaxform run' folder")
+    try:  # a frame of a run measured against another tool: the run's rig is the reference
+        return (_load_run(frame_of) if frame_of is not None else None), None, preset
+    except ValueError:
+        return None, None, preset
 
 
 # ---------------------------------------------------------------------------------------------
@@ -340,117 +368,67 @@ def run(args) -> int:
     mesh_path = pathlib.Path(args.mesh)
     if not mesh_path.exists():
         raise FileNotFoundError(f"no such mesh file: {mesh_path}")
-    forced: list[str] = []
-
-    # 2. the run the mesh comes from, if any, and the tool
-    spec = args.tool
-    frame_of = _run_of_frame(mesh_path)
-    run_dir = None
-    if spec == "run":
-        if frame_of is None:
-            raise ValueError(f"--tool run: {mesh_path} is not a frame of a 'jaxform run' folder (frames_#####.vtu "
-                             "beside frames.pvd and summary.json); give the run folder: --tool RUN_DIR")
-        run_dir = frame_of
-    elif spec is not None and pathlib.Path(spec).is_dir():
-        if not _is_run_folder(pathlib.Path(spec)):
-            raise ValueError(f"--tool {spec}: a directory but not a 'jaxform run' folder (no summary.json and "
-                             "frames.pvd)")
-        run_dir = pathlib.Path(spec)
-    elif spec is None:
-        if frame_of is None:
-            raise ValueError(f"--tool is required: {mesh_path} is not a frame of a 'jaxform run' folder, so the "
-                             "tool is unknown (a mesh file, a run folder, or a preset: " + ", ".join(PRESETS) + ")")
-        run_dir = frame_of
-    if run_dir is not None:
-        run = _load_run(run_dir)
-    elif frame_of is not None:  # --tool given for a frame of a run: its rig is the reference, if readable
-        try:
-            run = _load_run(frame_of)
-        except ValueError:
-            run, frame_of = None, None
-    else:
-        run = None
+    run, run_dir, preset = _where_the_tool_is(args.tool, mesh_path)
     case = run.case if run is not None else None
-    preset = None
-    if run_dir is None:
-        preset = _parse_preset(spec)
-        if preset is None and not pathlib.Path(spec).is_file():
-            raise ValueError(f"--tool {spec!r} is neither an existing file nor a preset ({', '.join(PRESETS)}) "
-                             "nor a 'jaxform run' folder")
-
-    h_run = float(case.ply_thickness) if case is not None else None
-    if args.ply_thickness_mm is None and h_run is None:
+    if args.ply_thickness_mm is None and case is None:
         raise ValueError("--ply-thickness-mm is required (the ply thickness h, mm) when MESH is not a frame of a "
                          "'jaxform run' folder")
-    h = args.ply_thickness_mm * 1e-3 if args.ply_thickness_mm is not None else h_run
-    if h_run is not None and not math.isclose(h, h_run, rel_tol=1e-6):
-        msg = (f"--ply-thickness-mm {args.ply_thickness_mm:g} but the run {run.folder} formed plies "
-               f"{h_run * 1e3:g} mm thick; leave it out to use the run's")
-        if not args.force:
-            raise ValueError(msg + ", or pass --force to measure with yours")
-        forced.append(msg)
-    n_plies = case.n_plies if case is not None else 1
-    ply = args.ply_index or 1
-    if case is not None and ply > n_plies:
+    n_plies, ply = (case.n_plies if case is not None else 1), args.ply_index or 1
+    if ply > n_plies and case is not None:
         raise ValueError(f"--ply-index {ply}: the run {run.folder} has {n_plies} ply(ies)")
 
-    # 3. read everything (files are checked; nothing written yet)
-    units = args.units
-    if frame_of is not None and units == "auto":
-        units = "m"  # jaxform writes metres
-    nodes, faces, data = _read_checked(read_surface, mesh_path, units, args.force, forced, point_data=True)
+    # 2. read everything and measure the distance; what cannot be right is a problem (--force: a warning)
+    problems: list[str] = []
+    h_run = float(case.ply_thickness) if case is not None else None
+    h = args.ply_thickness_mm * 1e-3 if args.ply_thickness_mm is not None else h_run
+    if h_run is not None and not math.isclose(h, h_run, rel_tol=1e-6):
+        problems.append(f"--ply-thickness-mm {args.ply_thickness_mm:g} but the run {run.folder} formed plies "
+                        f"{h_run * 1e3:g} mm thick; leave it out to use the run's")
+    units = "m" if run is not None and args.units == "auto" else args.units  # jaxform writes metres
+    nodes, faces, data = _read_checked(read_surface, mesh_path, units, problems, point_data=True)
     if n_plies > 1 and "ply_id" in data:  # a frame of a stack: the ply measured
         nodes, faces = _select_ply(nodes, faces, data, ply, n_plies, mesh_path)
     rig_facts = None
     if run_dir is not None:
         tool, rig_facts = _run_tool(run, mesh_path)
-    else:
+    elif preset is not None:
         tool = preset
-        if tool is None:
-            tool_path = pathlib.Path(spec)
-            tv, tf = _read_checked(read_surface, tool_path, args.tool_units, args.force, forced, triangulate=True)
-            tool = _Tool(f"mesh {tool_path} ({len(tf)} triangles)", mesh=(tv, tf))
-            span_m = np.linalg.norm(np.ptp(nodes, axis=0))
-            span_t = np.linalg.norm(np.ptp(tv, axis=0))
-            if span_m > 0 and span_t > 0 and not (1e-2 < span_t / span_m < 1e2):
-                msg = (f"the mesh is {span_m:.4g} m across and the tool {span_t:.4g} m: mixed units? "
-                       "set --units and --tool-units (m or mm) explicitly")
-                if not args.force:
-                    raise ValueError(msg + ", or pass --force to measure anyway")
-                forced.append(msg)
-    cloud = _read_checked(read_point_cloud, args.cloud, args.cloud_units, args.force, forced) if args.cloud else None
-
-    # 4. the measurement, and the checks that it is a measurement of this part on this tool
+    else:
+        tv, tf = _read_checked(read_surface, args.tool, args.tool_units, problems, triangulate=True)
+        tool = _Tool(f"mesh {args.tool} ({len(tf)} triangles)", mesh=(tv, tf))
+        span_m, span_t = (np.linalg.norm(np.ptp(a, axis=0)) for a in (nodes, tv))
+        if span_m > 0 and span_t > 0 and not (1e-2 < span_t / span_m < 1e2):
+            problems.append(f"the mesh is {span_m:.4g} m across and the tool {span_t:.4g} m: mixed units? "
+                            "set --units and --tool-units (m or mm) explicitly")
+    cloud = _read_checked(read_point_cloud, args.cloud, args.cloud_units, problems) if args.cloud else None
     dcrit = float(M.d_crit(h, ply))
+    defect_at = dcrit + DEFECT_TOLERANCE * h
     phi = tool.signed(nodes)
     dist = np.abs(phi) if phi is not None else tool.distance(nodes)
-    problems = []
-    if frame_of is not None and run_dir is None:  # --tool given for a frame of a run: must agree with its rig
+    if run is not None and run_dir is None:  # --tool given for a frame of a run: must agree with its rig
         rig_tool, _ = _run_tool(run, mesh_path)
         gap = np.abs(dist - rig_tool.distance(nodes))
         if gap.max() > max(1e-3, h):
-            problems.append(f"--tool {spec} disagrees with the rig {frame_of} was formed on by up to "
+            problems.append(f"--tool {args.tool} disagrees with the rig {run.folder} was formed on by up to "
                             f"{gap.max() * 1e3:.3g} mm; leave --tool out (or --tool run) to measure against the "
                             f"run's own rig ({rig_tool.text})")
-    tol = max(0.5 * h, 1e-4)
-    if phi is not None and (phi < -tol).any():
-        inside = phi < -tol
+    inside = phi < -max(0.5 * h, 1e-4) if phi is not None else np.zeros(len(nodes), bool)
+    if inside.any():
         problems.append(f"{int(inside.sum())} of {len(nodes)} nodes are inside the tool ({tool.text}), up to "
                         f"{-phi.min() * 1e3:.3g} mm deep: the mesh is not where the tool is (wrong tool, pose, "
                         "offset or --units?)")
-    span = float(np.linalg.norm(np.ptp(nodes, axis=0)))
-    far = max(10.0 * dcrit, 0.05 * span)
+    far = max(10.0 * dcrit, 0.05 * float(np.linalg.norm(np.ptp(nodes, axis=0))))
     if dist.min() > far:
         problems.append(f"the closest node is {dist.min() * 1e3:.4g} mm from the tool ({tool.text}), more than "
                         f"{far * 1e3:.3g} mm: the part was not formed on this tool here (wrong tool, pose, offset "
                         "or --units?)")
     if problems and not args.force:
         raise ValueError("; ".join(problems) + ". Pass --force to measure anyway")
-    forced += problems
 
+    # 3. the metric (nothing written yet)
     k1, k2 = (np.asarray(k) for k in M.principal_curvatures(nodes, faces))
     km = np.maximum(np.abs(k1), np.abs(k2))
-    labels = np.asarray(M.classify_zones(dist, km, dcrit, kappa_threshold=args.kappa_threshold_per_m,
+    labels = np.asarray(M.classify_zones(dist, km, defect_at, kappa_threshold=args.kappa_threshold_per_m,
                                          faces=faces))
     areas = np.asarray(M.node_areas(nodes, faces))
     zarea = np.asarray(M.zone_areas(labels, areas))
@@ -469,7 +447,7 @@ def run(args) -> int:
     summary = {
         "mesh": str(args.mesh), "tool": tool.text, "n_nodes": int(len(nodes)),
         "n_faces": int(len(faces)), "ply_thickness_m": h, "ply_index": ply,
-        "d_crit_m": dcrit, "kappa_threshold_per_m": args.kappa_threshold_per_m,
+        "d_crit_m": dcrit, "defect_above_m": defect_at, "kappa_threshold_per_m": args.kappa_threshold_per_m,
         "zone_area_m2": {"conforming": float(zarea[0]), "bridging": float(zarea[1]),
                          "wrinkle": float(zarea[2])},
         "wrinkle_count": int(count),
@@ -478,12 +456,12 @@ def run(args) -> int:
         "distance_m": _stats(dist),
         "kappa_max_per_m": _stats(km),
         "kappa_max_defect_per_m": _stats(km[defect]) if defect.any() else None,
-        "forced": forced,
+        "forced": problems,
     }
     if rig_facts is not None:
         summary["rig"] = rig_facts
 
-    # 5. write (only now)
+    # 4. write (only now)
     out = prepare_output_dir(out, force=args.force, owner="wrinkles", replaces=OUTPUTS)
     written = [write_vtu(out / "wrinkles.vtu", nodes, faces, point_data={
         "distance_m": dist, "k1_per_m": k1, "k2_per_m": k2, "kappa_max_per_m": km,
@@ -506,7 +484,7 @@ def run(args) -> int:
                 fh.write("{:.6f},{:.6f},{:.6f},{:d}\n".format(*row))
         written.append(path)
         rows.append({"points_mm": text, "file": path.name,
-                     "wrinkle_count": int(M.count_section_wrinkles(val, valid, min_amplitude=dcrit)),
+                     "wrinkle_count": int(M.count_section_wrinkles(val, valid, min_amplitude=defect_at)),
                      "max_amplitude_m": float(val[valid].max()) if valid.any() else None})
     if rows:
         summary["sections"] = rows
@@ -520,7 +498,7 @@ def run(args) -> int:
     summary["wall_time_s"] = time.perf_counter() - t0
     (out / "summary.json").write_text(json.dumps(summary, indent=2))
     written.append(out / "summary.json")
-    for msg in forced:
+    for msg in problems:
         print(f"jaxform wrinkles: warning (--force): {msg}", file=sys.stderr)
     print(f"jaxform wrinkles: tool: {tool.text}")
     print(f"jaxform wrinkles: {summary['wrinkle_count']} wrinkle region(s), wrinkle area "

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from jaxform import units
+from helpers import central_difference
 from jaxform.materials import (
     NCF_FCIM359,
     TABLE1_LBM,
@@ -131,15 +132,8 @@ def test_asymmetric_law_uses_pos_and_neg_sides():
 
 
 def _fd_grad(f, params, eps_rel=1e-6):
-    out = []
-    for i in range(len(params)):
-        h = eps_rel * abs(params[i])
-        p_plus = list(params)
-        p_minus = list(params)
-        p_plus[i] += h
-        p_minus[i] -= h
-        out.append((f(*p_plus) - f(*p_minus)) / (2 * h))
-    return np.array(out)
+    return np.array([central_difference(lambda p: f(*p), params, eps_rel * abs(params[i]), index=i)
+                     for i in range(len(params))])
 
 
 @pytest.mark.parametrize("kappa", [0.0, -3.0, 0.5, 20.0, 400.0])
@@ -171,13 +165,8 @@ def test_shear_parameter_gradients_match_finite_differences():
     gc, gf = jax.grad(value, argnums=(0, 1))(jnp.asarray(coeffs), jnp.asarray(knots_f))
     for grad, base, which in ((gc, coeffs, 0), (gf, knots_f, 1)):
         for i in range(base.size):
-            h = 1e-4
-            plus, minus = base.copy(), base.copy()
-            plus[i] += h
-            minus[i] -= h
-            args_p = (plus, knots_f) if which == 0 else (coeffs, plus)
-            args_m = (minus, knots_f) if which == 0 else (coeffs, minus)
-            fd = (float(value(*args_p)) - float(value(*args_m))) / (2 * h)
+            fd = central_difference(lambda b: value(*((b, knots_f) if which == 0 else (coeffs, b))), base, 1e-4,
+                                    index=i)
             assert float(grad[i]) == pytest.approx(fd, rel=1e-6, abs=1e-9)
 
 

@@ -13,6 +13,7 @@ import pytest
 from jaxform import tools
 from jaxform.io.tool_mesh import hemisphere_rig_mesh
 from jaxform.metrics import ToolWarning, build_tool_index, tool_distance
+from helpers import central_difference
 
 
 def _ericson_closest(p, a, b, c):
@@ -115,13 +116,9 @@ def test_distance_jit_vmap_grad(small_tool):
     x = frames[0]
     g = np.asarray(jax.grad(lambda y: jnp.sum(tool_distance(y, v, f)))(x))
     assert np.all(np.isfinite(g))
-    eps = 1e-7
     for i in (0, 17, 42):
         for k in range(3):
-            xp, xm = x.copy(), x.copy()
-            xp[i, k] += eps
-            xm[i, k] -= eps
-            fd = (brute_distance(xp[i:i + 1], v, f) - brute_distance(xm[i:i + 1], v, f))[0] / (2 * eps)
+            fd = central_difference(lambda p: brute_distance(p, v, f), x[i:i + 1], 1e-7, index=(0, k))[0]
             assert abs(fd - g[i, k]) < 1e-5
 
 

@@ -186,6 +186,26 @@ def test_frame_of_a_run_is_measured_on_its_own_rig(small_run, tmp_path, capsys):
     assert np.all(zone[d0 > h] == 1)
 
 
+@pytest.mark.slow
+def test_each_ply_of_a_stack_against_the_tool_it_lies_on(tmp_path):
+    """Case B (two plies): ply i lies at (i - 1/2) h from the punch and (n - i + 1/2) h from the die;
+    one d_crit for both sides called the whole flange of ply 1 bridging (61876 of 62500 mm^2)."""
+    run = tmp_path / "b"
+    assert main(["run", "case-b-woven-nlbm", "--out", str(run), "--element-size-mm", "25",
+                 "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
+    frame = meshio.read(run / "frames_00002.vtu")
+    ply_id = frame.point_data["ply_id"].ravel()
+    for ply in (1, 2):
+        out = tmp_path / f"w{ply}"
+        assert main(["wrinkles", str(run / "frames_00002.vtu"), "--ply-index", str(ply), "--out", str(out)]) == 0
+        w = meshio.read(out / "wrinkles.vtu")
+        np.testing.assert_array_equal(w.points, frame.points[ply_id == ply])
+        excess = w.point_data["excess_over_d_crit_m"]
+        assert np.abs(excess - frame.point_data["deviation_m"][ply_id == ply]).max() < 1e-6  # 4e-9 m
+        s = json.loads((out / "summary.json").read_text())
+        assert s["zone_area_m2"]["bridging"] < 0.25 * 0.25 / 4  # the die opening, not the flange
+
+
 def test_a_frame_with_a_tool_that_is_not_its_rig(small_run, tmp_path, capsys):
     frame = small_run / "frames_00002.vtu"
     out = tmp_path / "w"

@@ -107,22 +107,25 @@ class _Tool:
     dz: tuple = ()
     mesh: tuple | None = None
 
-    def signed(self, nodes) -> np.ndarray | None:
-        """(N,) signed distance, m (negative inside a tool), or None for a mesh tool."""
-        if self.mesh is not None:
-            return None
-        from jaxform import tools
+    offsets: tuple | None = None  # the nominal distance of the ply's mid-surface to each tool, m
 
-        phi = [np.asarray(tools.sdf(t, nodes, dz)[0], dtype=np.float64) for t, dz in zip(self.analytic, self.dz)]
-        return np.min(np.stack(phi), axis=0)
-
-    def distance(self, nodes) -> np.ndarray:
-        """(N,) unsigned distance to the tool surface, m."""
+    def measure(self, nodes, dcrit: float):
+        """``(distance, d_crit, phi)``: (N,) distance to the tool the node conforms to, m; (N,)
+        its d_crit there (``dcrit``, or that tool's offset); (N,) signed distance to the nearest
+        tool (negative inside), or None for a mesh tool. The tool a node conforms to is the one it
+        exceeds its offset least (a stack's ply i: punch at (i - 1/2) h, die at (n - i + 1/2) h)."""
         if self.mesh is not None:
             from jaxform import metrics as M
 
-            return np.asarray(M.tool_distance(nodes, *self.mesh, check=False), dtype=np.float64)
-        return np.abs(self.signed(nodes))
+            d = np.asarray(M.tool_distance(nodes, *self.mesh, check=False), dtype=np.float64)
+            return d, np.full(len(d), dcrit), None
+        from jaxform import tools
+
+        phi = np.stack([np.asarray(tools.sdf(t, nodes, dz)[0], np.float64) for t, dz in zip(self.analytic, self.dz)])
+        off = np.asarray(self.offsets if self.offsets is not None else (dcrit,) * len(phi))[:, None]
+        j = np.argmin(phi - off, axis=0)[None]
+        return (np.abs(np.take_along_axis(phi, j, 0)[0]), np.take_along_axis(np.broadcast_to(off, phi.shape), j, 0)[0],
+                phi.min(axis=0))
 
 
 def _parse_preset(spec: str):
@@ -206,9 +209,9 @@ def _load_run(folder: pathlib.Path) -> _Run:
     return _Run(folder, case, summary, frames)
 
 
-def _run_tool(run: _Run, mesh: pathlib.Path):
+def _run_tool(run: _Run, mesh: pathlib.Path, h: float, ply: int):
     """The rig of ``run`` posed at the time of frame ``mesh`` (the run's last frame when ``mesh`` is
-    not one of its frames): ``(tool, rig_facts)``."""
+    not one of its frames), ply ``ply`` of thickness ``h``: ``(tool, rig_facts)``."""
     from jaxform import tools
     from jaxform.forming.rig import build_tools
 
@@ -234,7 +237,8 @@ def _run_tool(run: _Run, mesh: pathlib.Path):
              "tools": ["punch", "die"], "holder": "left out (as the run's deviation_m)"}
     text = (f"the rig of run {run.folder} at {when}, t = {t:.6g} s: punch moved down {down * 1e3:.4g} mm, die "
             "(holder left out)")
-    return _Tool(text, (rig.punch, rig.die), (-down, 0.0)), facts
+    n = run.case.n_plies
+    return _Tool(text, (rig.punch, rig.die), (-down, 0.0), offsets=((ply - 0.5) * h, (n - ply + 0.5) * h)), facts
 
 
 def _read_checked(reader, path, units, problems, **kw):
@@ -390,7 +394,7 @@ def run(args) -> int:
         nodes, faces = _select_ply(nodes, faces, data, ply, n_plies, mesh_path)
     rig_facts = None
     if run_dir is not None:
-        tool, rig_facts = _run_tool(run, mesh_path)
+        tool, rig_facts = _run_tool(run, mesh_path, h, ply)
     elif preset is not None:
         tool = preset
     else:
@@ -402,12 +406,11 @@ def run(args) -> int:
                             "set --units and --tool-units (m or mm) explicitly")
     cloud = _read_checked(read_point_cloud, args.cloud, args.cloud_units, problems) if args.cloud else None
     dcrit = float(M.d_crit(h, ply))
-    defect_at = dcrit + DEFECT_TOLERANCE * h
-    phi = tool.signed(nodes)
-    dist = np.abs(phi) if phi is not None else tool.distance(nodes)
+    dist, dcrit_node, phi = tool.measure(nodes, dcrit)
+    excess = dist - dcrit_node  # a run's rig: its deviation_m
     if run is not None and run_dir is None:  # --tool given for a frame of a run: must agree with its rig
-        rig_tool, _ = _run_tool(run, mesh_path)
-        gap = np.abs(dist - rig_tool.distance(nodes))
+        rig_tool, _ = _run_tool(run, mesh_path, h, ply)
+        gap = np.abs(dist - rig_tool.measure(nodes, dcrit)[0])
         if gap.max() > max(1e-3, h):
             problems.append(f"--tool {args.tool} disagrees with the rig {run.folder} was formed on by up to "
                             f"{gap.max() * 1e3:.3g} mm; leave --tool out (or --tool run) to measure against the "
@@ -428,7 +431,7 @@ def run(args) -> int:
     # 3. the metric (nothing written yet)
     k1, k2 = (np.asarray(k) for k in M.principal_curvatures(nodes, faces))
     km = np.maximum(np.abs(k1), np.abs(k2))
-    labels = np.asarray(M.classify_zones(dist, km, defect_at, kappa_threshold=args.kappa_threshold_per_m,
+    labels = np.asarray(M.classify_zones(excess, km, DEFECT_TOLERANCE * h, kappa_threshold=args.kappa_threshold_per_m,
                                          faces=faces))
     areas = np.asarray(M.node_areas(nodes, faces))
     zarea = np.asarray(M.zone_areas(labels, areas))
@@ -438,7 +441,8 @@ def run(args) -> int:
     profiles = []
     for text, a, b in sections:
         s, val, valid, height = (np.asarray(x) for x in M.section_profile(nodes, faces, dist, a, b, 400))
-        profiles.append((text, s, val, valid, height))
+        ex = np.asarray(M.section_profile(nodes, faces, excess, a, b, 400)[1])
+        profiles.append((text, s, val, valid, height, ex))
     cd = None
     if cloud is not None:
         cd = np.asarray(M.tool_distance(cloud, nodes, np.asarray(quads_to_triangles(faces)), check=False))
@@ -447,7 +451,7 @@ def run(args) -> int:
     summary = {
         "mesh": str(args.mesh), "tool": tool.text, "n_nodes": int(len(nodes)),
         "n_faces": int(len(faces)), "ply_thickness_m": h, "ply_index": ply,
-        "d_crit_m": dcrit, "defect_above_m": defect_at, "kappa_threshold_per_m": args.kappa_threshold_per_m,
+        "d_crit_m": dcrit, "defect_tolerance_m": DEFECT_TOLERANCE * h, "kappa_threshold_per_m": args.kappa_threshold_per_m,
         "zone_area_m2": {"conforming": float(zarea[0]), "bridging": float(zarea[1]),
                          "wrinkle": float(zarea[2])},
         "wrinkle_count": int(count),
@@ -465,7 +469,7 @@ def run(args) -> int:
     out = prepare_output_dir(out, force=args.force, owner="wrinkles", replaces=OUTPUTS)
     written = [write_vtu(out / "wrinkles.vtu", nodes, faces, point_data={
         "distance_m": dist, "k1_per_m": k1, "k2_per_m": k2, "kappa_max_per_m": km,
-        "wrinkle_radius_m": radius, "zone": labels.astype(np.int32),
+        "excess_over_d_crit_m": excess, "wrinkle_radius_m": radius, "zone": labels.astype(np.int32),
         "wrinkle_region": np.asarray(region), "node_area_m2": areas})]
     written.append(P.plot_node_field(out / "distance.png", nodes, faces, dist, scale=1e3,
                                      title="Distance to the tool", label="d (mm)"))
@@ -476,7 +480,7 @@ def run(args) -> int:
                                 title=f"Zones (d_crit {dcrit * 1e3:g} mm, "
                                 f"kappa >= {args.kappa_threshold_per_m:g} 1/m)"))
     rows = []
-    for k, (text, s, val, valid, height) in enumerate(profiles):
+    for k, (text, s, val, valid, height, ex) in enumerate(profiles):
         path = out / f"section_{k}.csv"
         with open(path, "w") as fh:
             fh.write("s_mm,amplitude_mm,height_mm,valid\n")
@@ -484,7 +488,7 @@ def run(args) -> int:
                 fh.write("{:.6f},{:.6f},{:.6f},{:d}\n".format(*row))
         written.append(path)
         rows.append({"points_mm": text, "file": path.name,
-                     "wrinkle_count": int(M.count_section_wrinkles(val, valid, min_amplitude=defect_at)),
+                     "wrinkle_count": int(M.count_section_wrinkles(ex, valid, min_amplitude=DEFECT_TOLERANCE * h)),
                      "max_amplitude_m": float(val[valid].max()) if valid.any() else None})
     if rows:
         summary["sections"] = rows

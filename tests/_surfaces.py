@@ -112,3 +112,20 @@ def cube_sphere(R: float, h: float, kind: str):
     if kind == "tri":
         F = np.concatenate([F[:, [0, 1, 2]], F[:, [0, 2, 3]]])
     return nodes, F
+
+
+def draped_sheet(h=0.001, half=0.035, R=0.05, H_PLY=0.3e-3):
+    """A ply of thickness ``H_PLY`` lying on a hemisphere of radius ``R`` (mid-plane at 0.9 h/2 from it), with a 1.5 mm bump of
+    radius ~2 mm (a wrinkle) at (18, 0) mm and a region lifted smoothly by 2 mm over a 14 mm radius
+    (bridging) at (-20, 0) mm; ``h`` is the node spacing. Returns nodes, faces, bump and lift (m) per node."""
+    n = int(round(2 * half / h)) + 1
+    s = np.linspace(-half, half, n)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    bump = 0.0015 * np.exp(-((X - 0.018) ** 2 + Y**2) / 0.0015**2)
+    rho = np.hypot(X + 0.020, Y)
+    lift = np.where(rho < 0.014, 0.002 * np.cos(0.5 * np.pi * rho / 0.014) ** 2, 0.0)
+    extra = bump + lift
+    r = R + 0.45 * H_PLY + extra  # radial position: distance to the sphere = 0.45 h + extra
+    dirs = np.stack([X, Y, np.sqrt(R**2 - X**2 - Y**2)], -1) / R
+    nodes = (dirs * r[..., None]).reshape(-1, 3)
+    return nodes, grid_faces(n, n, "quad"), bump.ravel(), lift.ravel()

@@ -8,7 +8,7 @@ import pytest
 
 from jaxform.cli import main
 from jaxform.io.surface import UnitsWarning, read_point_cloud, read_surface, write_vtu
-from test_metrics_wrinkles import draped_sheet
+from _surfaces import draped_sheet
 
 
 @pytest.fixture(scope="module")

@@ -4,7 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from _surfaces import grid_faces
+from _surfaces import draped_sheet, grid_faces
 from jaxform.tools import hemisphere_rig
 from jaxform.metrics import (
     BRIDGING,
@@ -28,23 +28,6 @@ from jaxform.metrics import (
 
 R = 0.05
 H_PLY = 0.3e-3
-
-
-def draped_sheet(h=0.001, half=0.035):
-    """A ply lying on the hemisphere (mid-plane at 0.9 h/2 from it), with a 1.5 mm bump of
-    radius ~2 mm (a wrinkle) at (18, 0) mm and a region lifted smoothly by 2 mm over a 14 mm radius
-    (bridging) at (-20, 0) mm. Returns nodes, faces, the imposed lift (m) per node."""
-    n = int(round(2 * half / h)) + 1
-    s = np.linspace(-half, half, n)
-    X, Y = np.meshgrid(s, s, indexing="ij")
-    bump = 0.0015 * np.exp(-((X - 0.018) ** 2 + Y**2) / 0.0015**2)
-    rho = np.hypot(X + 0.020, Y)
-    lift = np.where(rho < 0.014, 0.002 * np.cos(0.5 * np.pi * rho / 0.014) ** 2, 0.0)
-    extra = bump + lift
-    r = R + 0.45 * H_PLY + extra  # radial position: distance to the sphere = 0.45 h + extra
-    dirs = np.stack([X, Y, np.sqrt(R**2 - X**2 - Y**2)], -1) / R
-    nodes = (dirs * r[..., None]).reshape(-1, 3)
-    return nodes, grid_faces(n, n, "quad"), bump.ravel(), lift.ravel()
 
 
 def test_d_crit():

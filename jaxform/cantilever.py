@@ -77,6 +77,13 @@ class CantileverResult:
     nodes: Any
     iterations: Any = None
 
+    def __repr__(self) -> str:
+        try:
+            return (f"CantileverResult(points={len(self.x)}, tip_angle={float(self.tip_angle):.4g} rad, "
+                    f"tip_deflection={float(self.tip_deflection):.4g} m)")
+        except TypeError:  # traced values inside jit/grad
+            return "CantileverResult(traced)"
+
 
 def _row_positions(overhang, n_elements, grading):
     """Node rows along the strip: ``x_0 = -e_0/2`` (ghost, clamped), ``x_1 = +e_0/2`` (clamped),
@@ -228,19 +235,13 @@ def _path(g, load_steps, stiffen_steps, alpha0, tol, tol_path):
     return np.asarray(gs), np.asarray(al), np.asarray(tols)
 
 
-_HOST_CACHE: dict = {}
-
-
+@functools.lru_cache(maxsize=64)
 def _strip_data(overhang, width, n_elements, n_width, grading=1.0):
-    key = (overhang, width, n_elements, n_width, grading)
-    if key not in _HOST_CACHE:
-        if len(_HOST_CACHE) > 64:
-            _HOST_CACHE.clear()
-        mesh, free, line = _strip(overhang, width, n_elements, n_width, grading)
-        free_idx = np.nonzero(free)[0]
-        _HOST_CACHE[key] = (mesh, free_idx, line, _symmetry_basis(mesh, free_idx, n_width),
-                            _hessian_colouring(mesh, free_idx))
-    return _HOST_CACHE[key]
+    """Host tables of a strip (mesh, free dofs, profile line, symmetry basis, Hessian colouring),
+    built once per strip geometry (plain numbers as the key: a fit solves the same strip many times)."""
+    mesh, free, line = _strip(overhang, width, n_elements, n_width, grading)
+    free_idx = np.nonzero(free)[0]
+    return mesh, free_idx, line, _symmetry_basis(mesh, free_idx, n_width), _hessian_colouring(mesh, free_idx)
 
 
 def _symmetry_basis(mesh: Mesh, free_idx: np.ndarray, n_width: int) -> np.ndarray:

@@ -20,3 +20,11 @@ def test_readme_python_block_runs_as_written():
     top = np.hypot(env["nodes"][:, 0], env["nodes"][:, 1]) < 0.02
     assert top.any()
     np.testing.assert_allclose(np.asarray(d)[top], 0.5 * env["case"].ply_thickness, atol=0.3e-3)
+
+
+def test_results_have_short_reprs():
+    from jaxform import cantilever
+    from jaxform.materials import WOVEN_38616
+
+    strip = cantilever.simulate(WOVEN_38616.bending[0], overhang=0.1, areal_mass=0.21, n_elements=10)
+    assert len(repr(strip)) < 120 and "tip_angle" in repr(strip)

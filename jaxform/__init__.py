@@ -6,11 +6,13 @@ Modules along the data flow (imports point one way along it)::
 
     units, materials          laws and presets (SI)
     mesh, shell               the fabric shell: one kernel for every use
+    geometry                  safe maths, point-triangle closest points, the nearest-triangle search
     tools, contact            rigid tools, penalty contact with regularised Coulomb friction
     model, integrate          fixed model / changing state, explicit central differences
-    cases, forming            hemisphere forming cases (TOML) and their runs
-    cantilever, frame_tests   lab tests built on the same shell (cantilever, picture frame, bias extension)
     metrics                   wrinkle metric: tool distance, principal curvatures, zones
+    forming, cases            hemisphere forming runs (case, presets, rig, fields, summary, driver); the user edge
+    statics                   one static solver (damped Newton) with its implicit-function gradient
+    cantilever, frame_tests   lab tests built on the same shell (cantilever, picture frame, bias extension)
     calibrate                 fitting laws to measurements through the model
 
 ``jaxform.simulate(case)`` runs a forming case (a ``Case``, a preset name or a ``.toml`` path).
@@ -32,8 +34,10 @@ _MODULES = (
     "contact",
     "model",
     "integrate",
+    "geometry",
     "cases",
     "forming",
+    "statics",
     "cantilever",
     "frame_tests",
     "metrics",

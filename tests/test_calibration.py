@@ -159,15 +159,24 @@ def _write(path, x_mm, z_mm, header="x_mm,z_mm"):
     return path
 
 
-def test_profile_csv_any_order_gaps_duplicates(tmp_path):
+def test_profile_csv_any_order_duplicates(tmp_path):
     x = np.linspace(0, 80, 30)
     z = -0.01 * x**2
     idx = np.random.default_rng(0).permutation(30)
     p = tmp_path / "p.csv"
-    p.write_text("x_mm,z_mm\n" + "\n".join(f"{x[i]},{z[i]}" for i in idx) + "\n10.0,\n10.0,nan\n")
+    p.write_text("x_mm,z_mm\n" + "\n".join(f"{x[i]},{z[i]}" for i in idx) + f"\n{x[3]},{z[3]}\n")
     xm, zm = cf.read_profile_csv(p, overhang=0.1)
     assert np.all(np.diff(xm) > 0) and xm.size == 30
     np.testing.assert_allclose(zm, -0.01 * (xm * 1e3) ** 2 * 1e-3)
+
+
+def test_profile_csv_missing_values_are_refused_by_line(tmp_path):
+    """Rows with a gap used to be dropped silently; a gap usually means a broken export."""
+    x = np.linspace(0, 80, 30)
+    p = tmp_path / "p.csv"
+    p.write_text("# side profile\nx_mm,z_mm\n" + "\n".join(f"{a},{-0.01 * a * a}" for a in x) + "\n10.0,\n\n12.0,nan\n")
+    with pytest.raises(ValueError, match=r"2 rows with a missing or non-numeric value in x_mm,z_mm \(lines 33, 35\)"):
+        cf.read_profile_csv(p, overhang=0.1)
 
 
 @pytest.mark.parametrize("case,match", [
@@ -176,6 +185,8 @@ def test_profile_csv_any_order_gaps_duplicates(tmp_path):
     ("upward", "negative downwards"),
     ("far", "far from the clamp"),
     ("beyond", "beyond the overhang"),
+    ("metres", r"spans only 0.08 mm .* under 1 % of the 200 mm overhang; .* looks like a profile in metres"),
+    ("drop", "a drop beyond the overhang"),
 ])
 def test_profile_csv_errors(tmp_path, case, match):
     x = np.linspace(0, 80, 20)
@@ -188,6 +199,10 @@ def test_profile_csv_errors(tmp_path, case, match):
         p = _write(tmp_path / "p.csv", x, -z)
     elif case == "far":
         p = _write(tmp_path / "p.csv", x + 60, z)
+    elif case == "metres":
+        p = _write(tmp_path / "p.csv", x * 1e-3, z * 1e-3)
+    elif case == "drop":
+        p = _write(tmp_path / "p.csv", x * 0.5, z * 4)
     else:
         p = _write(tmp_path / "p.csv", x, z)
     with pytest.raises(ValueError, match=match):

@@ -93,3 +93,137 @@ def test_fit_shear_command_raw_frame_data(tmp_path):
     np.testing.assert_allclose(np.asarray(law.force(gamma)), fn, rtol=0.02, atol=0.02 * fn.max())
     r2 = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
     assert r2.returncode != 0 and "refusing to overwrite" in r2.stderr
+
+
+# ----- no plausible wrong answer with exit 0 (issue 14 item 3) ---------------------------------
+
+
+def _fit_shear_main():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("fit_shear_script", ROOT / "calibration" / "fit_shear.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.main
+
+
+def _cli(argv, capsys):
+    """Run calibration/fit_shear.py in-process → (exit status, stdout, stderr)."""
+    try:
+        rc = _fit_shear_main()([str(a) for a in argv])
+    except SystemExit as err:  # argparse's refusals
+        rc = err.code
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _woven_rows(n=40, deg_max=55):
+    g = np.radians(np.linspace(1, deg_max, n))
+    return g, np.asarray(WOVEN_38616.shear.force(g))
+
+
+def _raw_frame_csv(path, *, sign=1.0, n=40):
+    L = 0.145
+    g, fn = _woven_rows(n)
+    force = sign * fn * 2 * L * np.cos(np.pi / 4 - g / 2)
+    path.write_text("gamma_deg,force_N\n" + "\n".join(f"{a:.6f},{b:.8f}" for a, b in zip(np.degrees(g), force)) + "\n")
+    return path
+
+
+def _bad_input(tmp_path, case):
+    """(argv after --data, file) of one refused input."""
+    p = tmp_path / "frame.csv"
+    g, fn = _woven_rows()
+    if case == "negative_force":
+        return ["--frame-side-mm", 145], _raw_frame_csv(p, sign=-1.0)
+    if case in ("negative_side", "side_in_metres"):
+        return ["--frame-side-mm", -145 if case == "negative_side" else 0.145], _raw_frame_csv(p)
+    if case == "radians_as_degrees":
+        p.write_text("gamma_deg,f_norm_N_per_m\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(g, fn)) + "\n")
+    elif case == "degrees_as_radians":
+        p.write_text("gamma_rad,f_norm_N_per_m\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(np.degrees(g), fn)) + "\n")
+    elif case == "missing_value":
+        rows = [f"{a:.6f},{b:.6f}" for a, b in zip(np.degrees(g), fn)]
+        rows[6] = f"{np.degrees(g[6]):.6f},"
+        p.write_text("gamma_deg,f_norm_N_per_m\n" + "\n".join(rows) + "\n")
+    elif case == "displacement_in_metres_side":
+        d_mm = np.linspace(1, 60, 20)
+        p.write_text("displacement_mm,force_N\n" + "\n".join(f"{a},{0.1 * a}" for a in d_mm) + "\n")
+        return ["--frame-side-mm", 50], p
+    elif case == "few_points_for_degree":
+        p.write_text("gamma_deg,f_norm_N_per_m\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(np.degrees(g[::8]), fn[::8])) + "\n")
+        return ["--degree", 7], p
+    else:
+        p.write_text("gamma_deg,f_norm_N_per_m\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(np.degrees(g), fn)) + "\n")
+        return ["--degree", {"degree_40": 40, "degree_0": 0, "degree_negative": -3}[case]], p
+    return [], p
+
+
+@pytest.mark.parametrize("case,match", [
+    ("negative_force", r"39 of 40 rows have a force of the opposite sign to the shear angle \(lines 3, 4, .*flip the sign of force_N"),
+    ("negative_side", r"--frame-side-mm -145: must be > 0"),
+    ("side_in_metres", r"--frame-side-mm 0.145: .* looks like metres"),
+    ("radians_as_degrees", r"gamma_deg reaches only 0.96° .* look like radians: name the column gamma_rad"),
+    ("degrees_as_radians", r"gamma_rad reaches 55 rad .* look like degrees"),
+    ("missing_value", r"1 row with a missing or non-numeric value in gamma_deg,f_norm_N_per_m \(line 8\)"),
+    ("displacement_in_metres_side", r"displacement_mm reaches .* travels at most 29.29 mm"),
+    ("few_points_for_degree", r"5 distinct shear angles for 7 unknowns .* use degree <= 4"),
+    ("degree_40", r"--degree 40: must be an integer from 1 to 9"),
+    ("degree_0", r"--degree 0: must be an integer from 1 to 9"),
+    ("degree_negative", r"--degree -3: must be an integer from 1 to 9"),
+])
+def test_fit_shear_command_refuses_input(tmp_path, capsys, case, match):
+    """Each input that used to give a meaningless law with exit 0 (an all-zero law for negative
+    forces or side, coefficients of 3e15 for radians under gamma_deg, a wild degree-40 fit, degree
+    0 silently 7, -3 a crash) is refused at the edge: exit 2, the reason, nothing written."""
+    extra, data = _bad_input(tmp_path, case)
+    outs = [tmp_path / "shear.toml", tmp_path / "fit.json", tmp_path / "fit.png"]
+    rc, out, err = _cli(["--data", data, *extra, "--out", outs[0], "--json", outs[1], "--plot", outs[2]], capsys)
+    assert rc == 2, (out, err)
+    assert "fit_shear.py: error: " in err and "Traceback" not in err
+    assert __import__("re").search(match, err), err
+    assert not any(p.exists() for p in outs)
+
+
+def test_fit_shear_command_unconverged_fit_is_not_success(tmp_path, capsys):
+    """A straight line through the woven law: the fit runs, but its rmse is ~40x the data's
+    scatter; the command says so, records it in both files and exits 1."""
+    data = _raw_frame_csv(tmp_path / "frame.csv")
+    toml, js = tmp_path / "shear.toml", tmp_path / "fit.json"
+    rc, out, err = _cli(["--data", data, "--frame-side-mm", 145, "--degree", 1, "--out", toml, "--json", js], capsys)
+    assert rc == 1
+    assert "fit_shear.py: the fit did not converge: rmse" in err and "far above the data's scatter" in err
+    d = __import__("json").loads(js.read_text())
+    assert d["converged"] is False and "far above the data's scatter" in d["reason"]
+    assert "converged = false" in toml.read_text() and "NOT A VALID FIT" in toml.read_text()
+    with pytest.raises(ValueError, match="did not converge"):
+        cf.read_shear_toml(toml)
+
+
+def test_fit_reports_unmet_constraint_and_poor_rmse():
+    g = np.linspace(0.01, 1.0, 80)
+    f = 100 * g - 300 * g**2 + 250 * g**3  # a drop the non-decreasing law cannot follow
+    fit = C.fit_shear_polynomial(g, f, degree=3, monotone=True)
+    assert not fit.converged and "far above the data's scatter" in fit.reason
+    free = C.fit_shear_polynomial(g, f, degree=3, monotone=False)
+    assert free.converged and free.reason == ""  # exact data, exact form
+    good = C.fit_shear_polynomial(*_woven_rows(), degree=7)
+    assert good.converged and good.as_dict()["converged"] is True
+
+
+@pytest.mark.parametrize("degree,match", [(0, "from 1 to 9"), (-3, "from 1 to 9"), (40, "from 1 to 9"),
+                                          (2.5, "must be an integer"), (7, "for 7 unknowns")])
+def test_fit_degree_is_checked(degree, match):
+    g = np.linspace(0.1, 0.8, 6)
+    with pytest.raises(ValueError, match=match):
+        C.fit_shear_polynomial(g, 10 * g, degree=degree)
+    with pytest.raises(ValueError, match="stitch peak and 3 knots"):
+        C.fit_shear_ncf(g, 10 * g, degree=3)
+
+
+def test_data_scatter_estimates_the_noise():
+    rng = np.random.default_rng(4)
+    g = np.sort(rng.uniform(0.01, 1.0, 400))
+    f = np.asarray(WOVEN_38616.shear.force(g))
+    s = C.shear_fit.data_scatter(g, f + 0.3 * rng.normal(size=g.size))
+    assert s == pytest.approx(0.3, rel=0.15)

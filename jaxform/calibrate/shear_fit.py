@@ -19,6 +19,7 @@ from scipy.optimize import minimize
 from jaxform import frame_tests
 from jaxform.materials import PolynomialShear, ncf_shear
 
+
 @dataclasses.dataclass(frozen=True)
 class ShearFit:
     """Result of :func:`fit_shear_polynomial` / :func:`fit_shear_ncf`.
@@ -31,6 +32,12 @@ class ShearFit:
         gamma_range: (2,) fitted range, rad.
         rmse: RMS force residual, N/m.
         monotone: whether the (yarn) polynomial is non-decreasing on the range (checked densely).
+        scatter: the data's own scatter, N/m (robust estimate from each point's deviation from the
+            line through its neighbours in gamma; :func:`data_scatter`).
+        converged: whether the fit is one to use: the optimiser finished, the requested
+            non-decreasing constraint holds and ``rmse`` is within ``RMSE_OVER_SCATTER`` of the
+            scatter (floored at 0.5 % of the peak force). ``False`` comes with ``reason``.
+        reason: why ``converged`` is ``False`` ("" otherwise).
     """
 
     law: Any
@@ -41,15 +48,84 @@ class ShearFit:
     gamma_range: tuple
     rmse: float
     monotone: bool
+    scatter: float = float("nan")
+    converged: bool = True
+    reason: str = ""
 
     def as_dict(self) -> dict:
         d = {"kind": self.kind, "coeffs_N_per_m": [float(c) for c in self.coeffs],
              "gamma_range_rad": [float(v) for v in self.gamma_range], "rmse_N_per_m": self.rmse,
-             "monotone": bool(self.monotone)}
+             "monotone": bool(self.monotone), "scatter_N_per_m": float(self.scatter),
+             "converged": bool(self.converged), "reason": self.reason}
         if self.stitch_gamma_knots is not None:
             d["stitch_gamma_knots_rad"] = [float(v) for v in self.stitch_gamma_knots]
             d["stitch_force_knots_N_per_m"] = [float(v) for v in self.stitch_force_knots]
         return d
+
+
+MAX_DEGREE = 9
+"""Largest polynomial degree a fit accepts: odd powers of a shear angle up to ~1 rad beyond this
+only follow noise (and the least squares is ill-conditioned)."""
+RMSE_OVER_SCATTER = 4.0
+"""A fit whose rmse exceeds this many times the data's scatter (floored at ``SCATTER_FLOOR`` of the
+peak force) does not describe the data and is reported ``converged = False``."""
+SCATTER_FLOOR = 0.005
+
+
+def data_scatter(gamma, force) -> float:
+    """Robust scatter (standard deviation) of picture-frame data about a smooth curve, N/m.
+
+    Each interior point (sorted by gamma) is compared with the straight line through its two
+    neighbours; for independent noise of deviation ``s`` that difference has variance
+    ``s^2 (1 + w^2 + (1 - w)^2)`` (``w`` the interpolation weight); the mean of the scaled squares
+    without their largest 5 % (kinks, outliers), over 0.759 (that trimmed mean for Gaussian noise),
+    estimates ``s^2``. The mean, not the median, so noise that grows with the force (a relative
+    error) counts as much as a fit's rmse does. 0 for fewer than 3 distinct angles.
+    """
+    order = np.argsort(gamma, kind="stable")
+    g, f = np.asarray(gamma, float)[order], np.asarray(force, float)[order]
+    if g.size < 3:
+        return 0.0
+    g0, g1, g2 = g[:-2], g[1:-1], g[2:]
+    ok = g2 > g0
+    if not np.any(ok):
+        return 0.0
+    w = (g2[ok] - g1[ok]) / (g2[ok] - g0[ok])
+    e = f[1:-1][ok] - (w * f[:-2][ok] + (1.0 - w) * f[2:][ok])
+    q = np.sort(e**2 / (1.0 + w**2 + (1.0 - w) ** 2))
+    kept = q[: max(1, int(np.ceil(0.95 * q.size)))]
+    return float(np.sqrt(np.mean(kept) / 0.759))
+
+
+def _check_degree(degree, n_angles: int, extra: int, form: str) -> int:
+    """``degree`` as an int in ``1..MAX_DEGREE`` with more distinct angles than unknowns."""
+    if isinstance(degree, bool) or not isinstance(degree, (int, np.integer)) or not 1 <= degree <= MAX_DEGREE:
+        raise ValueError(f"shear fit: degree = {degree!r}: must be an integer from 1 to {MAX_DEGREE} "
+                         "(odd polynomial without a constant term; 7 suits woven data, 5 the NCF yarn part)")
+    unknowns = int(degree) + extra
+    if n_angles <= unknowns:
+        raise ValueError(
+            f"shear fit: {n_angles} distinct shear angles for {unknowns} unknowns (the {form} form of degree "
+            f"{degree}{' has 4 more: the stitch peak and 3 knots' if extra else ''}); the fit needs more points than "
+            f"unknowns — use degree <= {max(n_angles - 1 - extra, 0)} or more data"
+        )
+    return int(degree)
+
+
+def _verdict(gamma, force, rmse, *, monotone_wanted, monotone, solver_ok, solver_message) -> tuple[float, bool, str]:
+    """``(scatter, converged, reason)`` of a finished fit."""
+    scatter = data_scatter(gamma, force)
+    allowed = RMSE_OVER_SCATTER * max(scatter, SCATTER_FLOOR * float(np.max(np.abs(force))))
+    reasons = []
+    if not solver_ok:
+        reasons.append(f"the optimiser stopped without converging ({solver_message})")
+    if monotone_wanted and not monotone:
+        reasons.append("the non-decreasing constraint could not be met (dF/dg < 0 on part of the range): "
+                       "try a lower degree, or check the data for a drop")
+    if not np.isfinite(rmse) or rmse > allowed:
+        reasons.append(f"rmse {rmse:.4g} N/m is far above the data's scatter {scatter:.3g} N/m (allowed "
+                       f"{allowed:.3g} N/m): the fitted law does not follow the data — try another degree or form")
+    return scatter, not reasons, "; ".join(reasons)
 
 
 def _check_shear_data(gamma, force):
@@ -68,7 +144,7 @@ def _check_shear_data(gamma, force):
 
 
 def _constrained_lsq(A, y, C, n_free_sign: int = 0):
-    """min |A c - y|^2 subject to C c >= 0 (SLSQP on column-scaled variables)."""
+    """min |A c - y|^2 subject to C c >= 0 (SLSQP on column-scaled variables) → ``(c, ok, message)``."""
     scale = np.linalg.norm(A, axis=0)
     scale[scale == 0] = 1.0
     As = A / scale
@@ -76,7 +152,7 @@ def _constrained_lsq(A, y, C, n_free_sign: int = 0):
     c0, *_ = np.linalg.lstsq(As, y, rcond=None)
     ynorm = max(float(np.linalg.norm(y)), 1e-300)
     if Cs is None or np.all(Cs @ c0 >= -1e-12 * np.linalg.norm(Cs, axis=1) * np.linalg.norm(c0)):
-        return c0 / scale
+        return c0 / scale, True, ""
 
     def f(c):
         r = As @ c - y
@@ -90,7 +166,7 @@ def _constrained_lsq(A, y, C, n_free_sign: int = 0):
     res = minimize(f, c0, jac=grad, method="SLSQP",
                    constraints=[{"type": "ineq", "fun": lambda c: Cn @ c, "jac": lambda c: Cn}],
                    options={"maxiter": 500, "ftol": 1e-14})
-    return res.x / scale
+    return res.x / scale, bool(res.success), f"SLSQP: {res.message}"
 
 
 def _monotone_rows(degree: int, gmax: float, n: int = 1000):
@@ -111,20 +187,27 @@ def fit_shear_polynomial(gamma, force, *, degree: int = 7, monotone: bool = True
     Args:
         gamma: (n,) shear angles, rad (negative values use the odd symmetry).
         force: (n,) normalised shear force, N/m.
-        degree: polynomial degree (no constant term).
+        degree: polynomial degree (no constant term), 1 to ``MAX_DEGREE``, below the number of
+            distinct angles.
         monotone: constrain ``dF/dg >= 0`` on ``[0, max |gamma|]``.
+
+    Raises ``ValueError`` for invalid data or degree. A fit that ran but is not to be used (the
+    constraint not met, rmse far above the data's scatter) is returned with ``converged = False``
+    and a ``reason``.
     """
     gamma, force = _check_shear_data(gamma, force)
+    degree = _check_degree(degree, np.unique(np.abs(gamma)).size, 0, "polynomial")
     a, s = np.abs(gamma), np.where(gamma < 0, -1.0, 1.0)
     i = np.arange(1, degree + 1)
     A = s[:, None] * a[:, None] ** i[None, :]
     gmax = float(a.max())
     C = _monotone_rows(degree, gmax) if monotone else None
-    c = _constrained_lsq(A, force, C)
+    c, ok, msg = _constrained_lsq(A, force, C)
     law = PolynomialShear(c)
     rmse = float(np.sqrt(np.mean((A @ c - force) ** 2)))
     mono = _is_monotone(c, gmax, force)
-    return ShearFit(law, "polynomial", c, None, None, (float(gamma.min()), float(gamma.max())), rmse, mono)
+    verdict = _verdict(gamma, force, rmse, monotone_wanted=monotone, monotone=mono, solver_ok=ok, solver_message=msg)
+    return ShearFit(law, "polynomial", c, None, None, (float(gamma.min()), float(gamma.max())), rmse, mono, *verdict)
 
 
 def _hat(g, knots):
@@ -144,6 +227,7 @@ def fit_shear_ncf(gamma, force, *, degree: int = 5, monotone: bool = True, knots
     yarn and stitch terms best; positive-only data work when the stitch loads a part of the range.
     """
     gamma, force = _check_shear_data(gamma, force)
+    degree = _check_degree(degree, np.unique(gamma).size, 4, "ncf")
     a, s = np.abs(gamma), np.where(gamma < 0, -1.0, 1.0)
     i = np.arange(1, degree + 1)
     P = s[:, None] * a[:, None] ** i[None, :]
@@ -161,9 +245,9 @@ def fit_shear_ncf(gamma, force, *, degree: int = 5, monotone: bool = True, knots
     def solve(u):
         k = knots_of(u)
         A = np.concatenate([P, np.where(gamma >= 0, _hat(gamma, k), 0.0)[:, None]], axis=1)
-        c = _constrained_lsq(A, force, C)
+        c, ok, msg = _constrained_lsq(A, force, C)
         r = A @ c - force
-        return float(r @ r), c, k
+        return float(r @ r), c, k, ok, msg
 
     def inv_softplus(v):
         return np.log(np.expm1(max(v, 1e-6)))
@@ -172,14 +256,17 @@ def fit_shear_ncf(gamma, force, *, degree: int = 5, monotone: bool = True, knots
     u0 = np.array([inv_softplus(k0[0]), inv_softplus(k0[1] - k0[0]), inv_softplus(k0[2] - k0[1])])
     best = minimize(lambda u: solve(u)[0], u0, method="Nelder-Mead",
                     options={"xatol": 1e-6, "fatol": 1e-10 * float(force @ force), "maxiter": 2000})
-    _, c, k = solve(best.x)
+    _, c, k, ok, msg = solve(best.x)
+    if not best.success:
+        ok, msg = False, f"Nelder-Mead on the stitch knots: {best.message}" + (f"; {msg}" if msg else "")
     coeffs, fp = c[:degree], float(c[degree])
     law = ncf_shear(coeffs, k, [0.0, fp, 0.0])
     pred = np.asarray(law.force(jnp.asarray(gamma)))
     rmse = float(np.sqrt(np.mean((pred - force) ** 2)))
     mono = _is_monotone(coeffs, gmax, force)
+    verdict = _verdict(gamma, force, rmse, monotone_wanted=monotone, monotone=mono, solver_ok=ok, solver_message=msg)
     return ShearFit(law, "ncf", coeffs, np.asarray(k), np.array([0.0, fp, 0.0]),
-                    (float(gamma.min()), float(gamma.max())), rmse, mono)
+                    (float(gamma.min()), float(gamma.max())), rmse, mono, *verdict)
 
 
 def picture_frame_normalised_force(force, gamma, frame_side):
@@ -213,5 +300,5 @@ def check_shear_fit(fit: ShearFit, *, gamma_max: float | None = None, **rig_kwar
     return {"gamma": g, "simulated": sim, "expected": exp, "max_rel_diff": float(np.max(np.abs(sim - exp)) / scale)}
 
 
-__all__ = ["ShearFit", "fit_shear_polynomial", "fit_shear_ncf", "picture_frame_normalised_force",
+__all__ = ["ShearFit", "MAX_DEGREE", "data_scatter", "fit_shear_polynomial", "fit_shear_ncf", "picture_frame_normalised_force",
            "picture_frame_shear_angle", "check_shear_fit"]

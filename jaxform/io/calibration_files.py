@@ -9,25 +9,36 @@ from __future__ import annotations
 import csv
 import json
 import math
+import os
 import pathlib
 import tomllib
 
 import numpy as np
 
 MIN_POINTS = 5
+MIN_GAMMA_DEG = 1.2  # a gamma_deg column that never reaches this is in radians
+MAX_GAMMA_RAD = 1.5  # a gamma_rad column beyond this (86°) is in degrees
+MIN_PROFILE_FRACTION = 0.01  # a profile spanning less of its overhang is in the wrong unit
 
 
 def _read_columns(path, owner: str) -> dict[str, np.ndarray]:
+    """Columns of a CSV (lower-case header names → float arrays, missing values as NaN).
+
+    The key ``"#line"`` holds each data row's line number in the file (comments and blank lines
+    counted), for messages that name rows.
+    """
     path = pathlib.Path(path)
     if not path.is_file():
         raise ValueError(f"{owner}: {path}: no such file")
     with path.open(newline="") as fh:
-        rows = [r for r in csv.reader(fh) if r and not r[0].lstrip().startswith("#")]
+        reader = csv.reader(fh)
+        rows = [(reader.line_num, r) for r in reader if r and not r[0].lstrip().startswith("#")]
     if not rows:
         raise ValueError(f"{owner}: {path} is empty")
-    header = [h.strip().lower() for h in rows[0]]
+    header = [h.strip().lower() for h in rows[0][1]]
     cols: dict[str, list] = {h: [] for h in header}
-    for lineno, row in enumerate(rows[1:], start=2):
+    lines = []
+    for lineno, row in rows[1:]:
         if len(row) != len(header):
             raise ValueError(f"{owner}: {path} line {lineno}: {len(row)} fields, header has {len(header)}")
         for h, v in zip(header, row):
@@ -36,34 +47,62 @@ def _read_columns(path, owner: str) -> dict[str, np.ndarray]:
                 cols[h].append(float(v) if v not in ("", "nan", "NaN") else math.nan)
             except ValueError:
                 raise ValueError(f"{owner}: {path} line {lineno}: {h} = {v!r} is not a number") from None
-    return {h: np.asarray(v, float) for h, v in cols.items()}
+        lines.append(lineno)
+    out = {h: np.asarray(v, float) for h, v in cols.items()}
+    out["#line"] = np.asarray(lines, int)
+    return out
+
+
+def _header(cols) -> str:
+    return ",".join(h for h in cols if h != "#line")
+
+
+def _lines_text(lines) -> str:
+    lines = [int(v) for v in lines]
+    shown = ", ".join(str(v) for v in lines[:10])
+    return f"line{'s' if len(lines) > 1 else ''} {shown}" + (f" (and {len(lines) - 10} more)" if len(lines) > 10 else "")
+
+
+def _refuse_missing(owner, path, cols, names, show=None) -> None:
+    """Refuse rows with a missing or non-finite value in any of ``names``, naming their lines."""
+    bad = np.zeros(cols["#line"].shape, bool)
+    for n in names:
+        bad |= ~np.isfinite(cols[n])
+    names = [(show or {}).get(n, n) for n in names]
+    if np.any(bad):
+        raise ValueError(
+            f"{owner}: {path}: {int(bad.sum())} row{'s' if bad.sum() > 1 else ''} with a missing or non-numeric "
+            f"value in {','.join(names)} ({_lines_text(cols['#line'][bad])}); every row needs all of "
+            f"{','.join(names)} — delete those rows or fill them in"
+        )
 
 
 def read_profile_csv(path, overhang: float | None = None):
     """Read a cantilever side profile (header ``x_mm,z_mm``) and return ``(x, z)`` in m.
 
-    Points may come in any order, with gaps and noise: rows with a missing value are dropped,
-    points are sorted by x, repeated x are averaged. The file must describe a strip clamped
+    Points may come in any order and with noise: points are sorted by x, repeated x are averaged.
+    Every row must have both values (rows with a missing value are refused, by line number, not
+    dropped: a gap usually means a broken export). The file must describe a strip clamped
     horizontally at the origin and hanging down: x from near the clamp (>= -1 mm), z mostly
-    negative, at least 5 points, and (given ``overhang``, m) the horizontal extent no longer than
-    the strip.
+    negative, at least 5 points, and (given ``overhang``, m) the horizontal extent and the drop no
+    longer than the strip, and a profile spanning at least 1 % of it (a profile in metres in this
+    millimetre file spans 0.1 %).
 
     Raises:
-        ValueError: with what is wrong (missing columns, too few points, upward z, first point far
-            from the clamp, x beyond the overhang).
+        ValueError: with what is wrong (missing columns or values, too few points, upward z, first
+            point far from the clamp, x or z beyond the overhang, a profile in metres).
     """
     owner = "read_profile_csv"
     cols = _read_columns(path, owner)
     if "x_mm" not in cols or "z_mm" not in cols:
         raise ValueError(
-            f"{owner}: {path}: header is {', '.join(cols)}; it must have columns x_mm,z_mm "
+            f"{owner}: {path}: header is {_header(cols)}; it must have columns x_mm,z_mm "
             "(mm from the clamp edge, z negative downwards)"
         )
+    _refuse_missing(owner, path, cols, ("x_mm", "z_mm"))
     x, z = cols["x_mm"], cols["z_mm"]
-    ok = np.isfinite(x) & np.isfinite(z)
-    x, z = x[ok], z[ok]
     if x.size < MIN_POINTS:
-        raise ValueError(f"{owner}: {path}: {x.size} valid points; need at least {MIN_POINTS} along the strip")
+        raise ValueError(f"{owner}: {path}: {x.size} points; need at least {MIN_POINTS} along the strip")
     order = np.argsort(x, kind="stable")
     x, z = x[order], z[order]
     ux, inv = np.unique(x, return_inverse=True)
@@ -72,6 +111,17 @@ def read_profile_csv(path, overhang: float | None = None):
         x = ux
     if x.size < MIN_POINTS:
         raise ValueError(f"{owner}: {path}: {x.size} distinct x values; need at least {MIN_POINTS}")
+    if overhang is not None and not (np.isfinite(overhang) and overhang > 0):
+        raise ValueError(f"{owner}: overhang = {overhang!r} m: must be > 0")
+    if overhang is not None:
+        L_mm = overhang * 1e3
+        extent = max(float(x[-1] - min(x[0], 0.0)), float(np.max(np.abs(z))))
+        if extent < MIN_PROFILE_FRACTION * L_mm:
+            raise ValueError(
+                f"{owner}: {path}: the profile spans only {extent:.3g} mm (x up to {x[-1]:.3g} mm, |z| up to "
+                f"{np.max(np.abs(z)):.3g} mm), under {100 * MIN_PROFILE_FRACTION:g} % of the {L_mm:.4g} mm overhang; "
+                "x_mm,z_mm are millimetres — this looks like a profile in metres (multiply by 1000)"
+            )
     if x[0] < -1.0:
         raise ValueError(
             f"{owner}: {path}: x starts at {x[0]:.3g} mm; x is measured from the clamp edge (>= 0) "
@@ -96,12 +146,15 @@ def read_profile_csv(path, overhang: float | None = None):
         )
     xm, zm = x * 1e-3, z * 1e-3
     if overhang is not None:
-        if not (np.isfinite(overhang) and overhang > 0):
-            raise ValueError(f"{owner}: overhang = {overhang!r} m: must be > 0")
         if xm[-1] > overhang * 1.02:
             raise ValueError(
                 f"{owner}: {path}: x reaches {x[-1]:.4g} mm, beyond the overhang {overhang * 1e3:.4g} mm; "
                 "the horizontal extent of a hanging strip cannot exceed its length (check --overhang-mm)"
+            )
+        if np.max(-z) > overhang * 1e3 * 1.02:
+            raise ValueError(
+                f"{owner}: {path}: z reaches {np.min(z):.4g} mm, a drop beyond the overhang {overhang * 1e3:.4g} mm; "
+                "a strip cannot hang lower than its length (check --overhang-mm and the units of z_mm)"
             )
     return xm, zm
 
@@ -123,35 +176,85 @@ def read_shear_csv(path, frame_side: float | None = None):
     Accepted headers: ``gamma_rad`` or ``gamma_deg`` with ``f_norm_N_per_m``; or raw frame data
     ``gamma_deg``/``gamma_rad`` (or ``displacement_mm``) with ``force_N``, which needs
     ``frame_side`` (m, pin to pin) and is normalised ``F / (2 L cos(pi/4 - gamma/2))``.
+
+    Refused (``ValueError`` naming the file, the column or the rows): missing values (every row
+    needs both columns), a ``gamma_deg`` column that never reaches 1.2° (radians under a degree
+    header), a ``gamma_rad`` column beyond 1.5 rad (degrees), a displacement the frame cannot
+    travel, forces of the opposite sign to the shear angle (beyond 5 % of the peak: noise near
+    zero is fine) or all zero, a frame side that is not > 0.
     """
     owner = "read_shear_csv"
     cols = _read_columns(path, owner)
+    if frame_side is not None and not (np.isfinite(frame_side) and frame_side > 0):
+        raise ValueError(f"{owner}: frame side = {frame_side!r} m: must be > 0 (pin to pin)")
     if "gamma_rad" in cols:
-        gamma = cols["gamma_rad"]
+        gname = "gamma_rad"
     elif "gamma_deg" in cols:
-        gamma = np.radians(cols["gamma_deg"])
+        gname = "gamma_deg"
     elif "displacement_mm" in cols:
-        if frame_side is None:
-            raise ValueError(f"{owner}: {path}: displacement_mm needs the frame side length (--frame-side-mm)")
-        d = cols["displacement_mm"] * 1e-3
-        gamma = 0.5 * np.pi - 2.0 * np.arccos(np.sqrt(0.5) + d / (2.0 * frame_side))
+        gname = "displacement_mm"
     else:
         raise ValueError(
-            f"{owner}: {path}: header {', '.join(cols)}: need gamma_rad or gamma_deg (or displacement_mm) "
+            f"{owner}: {path}: header {_header(cols)}: need gamma_rad or gamma_deg (or displacement_mm) "
             "and f_norm_N_per_m (or force_N with the frame side)"
         )
     if "f_norm_n_per_m" in cols:
-        f = cols["f_norm_n_per_m"]
+        fname = "f_norm_n_per_m"
     elif "force_n" in cols:
-        if frame_side is None:
-            raise ValueError(f"{owner}: {path}: raw force_N needs the frame side length (--frame-side-mm)")
-        f = cols["force_n"] / (2.0 * frame_side * np.cos(0.25 * np.pi - 0.5 * gamma))
+        fname = "force_n"
     else:
-        raise ValueError(f"{owner}: {path}: no f_norm_N_per_m or force_N column")
-    ok = np.isfinite(gamma) & np.isfinite(f)
-    if ok.sum() < 3:
-        raise ValueError(f"{owner}: {path}: {ok.sum()} valid rows; need at least 3")
-    return gamma[ok], f[ok]
+        raise ValueError(f"{owner}: {path}: header {_header(cols)}: no f_norm_N_per_m or force_N column")
+    if (gname == "displacement_mm" or fname == "force_n") and frame_side is None:
+        raise ValueError(f"{owner}: {path}: {'displacement_mm' if gname == 'displacement_mm' else 'raw force_N'} "
+                         "needs the frame side length (--frame-side-mm)")
+    _refuse_missing(owner, path, cols, (gname, fname), show={"f_norm_n_per_m": "f_norm_N_per_m", "force_n": "force_N"})
+    fshow = {"f_norm_n_per_m": "f_norm_N_per_m", "force_n": "force_N"}[fname]
+    lines, raw_g, raw_f = cols["#line"], cols[gname], cols[fname]
+    if raw_g.size < 3:
+        raise ValueError(f"{owner}: {path}: {raw_g.size} rows; need at least 3")
+    gpeak = float(np.max(np.abs(raw_g)))
+    if gname == "gamma_deg" and gpeak < MIN_GAMMA_DEG:
+        raise ValueError(
+            f"{owner}: {path}: gamma_deg reaches only {gpeak:.3g}° while {fshow} reaches "
+            f"{np.max(np.abs(raw_f)):.4g}; a picture-frame test shears to tens of degrees — these look like "
+            "radians: name the column gamma_rad (or convert it to degrees)"
+        )
+    if gname == "gamma_rad" and gpeak > MAX_GAMMA_RAD:
+        raise ValueError(
+            f"{owner}: {path}: gamma_rad reaches {gpeak:.4g} rad (> {MAX_GAMMA_RAD} rad = 86°); these look like "
+            "degrees: name the column gamma_deg (or convert it to radians)"
+        )
+    if gname == "gamma_rad":
+        gamma = raw_g
+    elif gname == "gamma_deg":
+        gamma = np.radians(raw_g)
+    else:
+        d = raw_g * 1e-3
+        reach = (2.0 - math.sqrt(2.0)) * frame_side
+        bad = (d > reach) | (d < -math.sqrt(2.0) * frame_side)
+        if np.any(bad):
+            raise ValueError(
+                f"{owner}: {path}: displacement_mm reaches {raw_g[bad][0]:.4g} mm ({_lines_text(lines[bad])}); a frame "
+                f"of side {frame_side * 1e3:.4g} mm travels at most {reach * 1e3:.4g} mm (90° shear) — check the "
+                "units of displacement_mm (mm) and --frame-side-mm (pin to pin)"
+            )
+        gamma = 0.5 * np.pi - 2.0 * np.arccos(np.sqrt(0.5) + d / (2.0 * frame_side))
+    if fname == "f_norm_n_per_m":
+        f = raw_f
+    else:
+        f = raw_f / (2.0 * frame_side * np.cos(0.25 * np.pi - 0.5 * gamma))
+    peak = float(np.max(np.abs(f)))
+    if peak == 0.0:
+        raise ValueError(f"{owner}: {path}: {fshow} is zero on every row; there is no force to fit")
+    wrong = np.sign(gamma) * f < -0.05 * peak
+    if np.any(wrong):
+        raise ValueError(
+            f"{owner}: {path}: {int(wrong.sum())} of {f.size} rows have a force of the opposite sign to the shear "
+            f"angle ({_lines_text(lines[wrong])}, e.g. {gname} = {raw_g[wrong][0]:.4g}, {fshow} = "
+            f"{raw_f[wrong][0]:.4g}); the shear force has the sign of the shear angle — if the load cell reads "
+            f"tension as negative, flip the sign of {fshow}"
+        )
+    return gamma, f
 
 
 def _check_new(path, force: bool) -> pathlib.Path:
@@ -160,6 +263,17 @@ def _check_new(path, force: bool) -> pathlib.Path:
         raise FileExistsError(f"{path} exists; refusing to overwrite it (pass --force / force=True)")
     path.parent.mkdir(parents=True, exist_ok=True)
     return path
+
+
+def _write_whole(path: pathlib.Path, text: str) -> None:
+    """Write ``text`` to a temporary file beside ``path`` and rename it: an interrupted write
+    (Ctrl-C, a full disk) leaves no partial file."""
+    tmp = path.with_name(f".{path.name}.tmp")
+    try:
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    finally:
+        tmp.unlink(missing_ok=True)
 
 
 def _json_safe(v):
@@ -180,7 +294,7 @@ def _json_safe(v):
 def write_json(path, data: dict, *, force: bool = False) -> pathlib.Path:
     """Write ``data`` as JSON (non-finite numbers as null); refuses to overwrite unless ``force``."""
     path = _check_new(path, force)
-    path.write_text(json.dumps(_json_safe(data), indent=2) + "\n")
+    _write_whole(path, json.dumps(_json_safe(data), indent=2) + "\n")
     return path
 
 
@@ -195,22 +309,28 @@ def shear_toml(fit_dict: dict) -> str:
     def arr(v):
         return "[" + ", ".join(repr(float(x)) for x in v) + "]"
 
-    lines = ["# Shear law fitted by calibration/fit_shear.py (normalised force N/m, shear angle rad)",
-             "[fabric]", f"shear_poly_N_per_m = {arr(fit_dict['coeffs_N_per_m'])}", "", "[shear_fit]",
+    ok = fit_dict.get("converged", True)
+    lines = ["# Shear law fitted by calibration/fit_shear.py (normalised force N/m, shear angle rad)"]
+    if not ok:
+        lines += ["# NOT A VALID FIT, do not use it in a forming case: " + str(fit_dict.get("reason", ""))]
+    lines += ["[fabric]", f"shear_poly_N_per_m = {arr(fit_dict['coeffs_N_per_m'])}", "", "[shear_fit]",
              f'kind = "{fit_dict["kind"]}"']
     if fit_dict["kind"] == "ncf":
         lines += [f"stitch_gamma_knots_rad = {arr(fit_dict['stitch_gamma_knots_rad'])}",
                   f"stitch_force_knots_N_per_m = {arr(fit_dict['stitch_force_knots_N_per_m'])}"]
     lines += [f"gamma_range_rad = {arr(fit_dict['gamma_range_rad'])}",
               f"rmse_N_per_m = {float(fit_dict['rmse_N_per_m'])!r}",
-              f"monotone = {'true' if fit_dict.get('monotone', True) else 'false'}"]
+              f"monotone = {'true' if fit_dict.get('monotone', True) else 'false'}",
+              f"converged = {'true' if ok else 'false'}"]
+    if fit_dict.get("reason"):
+        lines.append(f"reason = {json.dumps(str(fit_dict['reason']), ensure_ascii=False)}")
     return "\n".join(lines) + "\n"
 
 
 def write_shear_toml(path, fit_dict: dict, *, force: bool = False) -> pathlib.Path:
     """Write :func:`shear_toml`; refuses to overwrite unless ``force``."""
     path = _check_new(path, force)
-    path.write_text(shear_toml(fit_dict))
+    _write_whole(path, shear_toml(fit_dict))
     return path
 
 
@@ -223,6 +343,9 @@ def read_shear_toml(path_or_text):
     fab, fit = data.get("fabric", {}), data.get("shear_fit", {})
     if "shear_poly_N_per_m" not in fab:
         raise ValueError("read_shear_toml: no [fabric] shear_poly_N_per_m = [...] in the file")
+    if fit.get("converged", True) is False:
+        raise ValueError(f"read_shear_toml: the file records a fit that did not converge ({fit.get('reason', 'no reason')}); "
+                         "refit the data (calibration/fit_shear.py) instead of using it")
     coeffs = fab["shear_poly_N_per_m"]
     if fit.get("kind", "polynomial") == "ncf":
         return ncf_shear(coeffs, fit["stitch_gamma_knots_rad"], fit["stitch_force_knots_N_per_m"])

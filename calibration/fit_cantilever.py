@@ -19,11 +19,19 @@ without --force.
 
 Progress goes to stderr, one update per optimiser iteration: a tqdm bar on a terminal, plain
 lines (at most one every ``--progress-every`` seconds, and the last) when stderr is a file or pipe.
+
+Input is checked before anything is fitted, and refused (``fit_cantilever.py: error: ...``, exit
+2, nothing written): an overhang or areal mass that is not > 0, a profile with missing values (the
+lines are named), a profile that spans under 1 % of its overhang (metres in the mm file), and
+what :func:`jaxform.io.calibration_files.read_profile_csv` refuses. A fit that did not converge
+writes params.json with ``converged: false`` and the ``reason``, says why on stderr and exits 1;
+Ctrl-C stops with a message, no params.json, exit 130.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import math
 import pathlib
 import sys
 import time
@@ -49,6 +57,12 @@ class _Progress:
             self.last = time.monotonic()
             print(f"fit [{self.label}] iteration {info.iteration}: {text}", file=sys.stderr, flush=True)
 
+    def abandon(self) -> None:
+        """End the display of a fit that stopped (interrupted or failed) without a summary line."""
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
     def close(self, fit) -> None:
         if self.bar is not None:
             self.bar.close()
@@ -57,13 +71,40 @@ class _Progress:
                   f"rmse {1e3 * fit.rmse:.4f} mm", file=sys.stderr, flush=True)
 
 
+PROG = "fit_cantilever.py"
+
+
 def _simulate_from_spec(spec: str):
+    """``MODULE:FUNCTION`` → the function; ``ValueError`` saying what could not be found."""
     mod, _, fn = spec.partition(":")
-    return getattr(importlib.import_module(mod), fn or "simulate")
+    try:
+        module = importlib.import_module(mod)
+    except ImportError as err:
+        raise ValueError(f"--simulate {spec}: cannot import {mod!r} ({err}); give MODULE:FUNCTION of a module on "
+                         "the Python path (default jaxform.cantilever:simulate)") from None
+    f = getattr(module, fn or "simulate", None)
+    if not callable(f):
+        raise ValueError(f"--simulate {spec}: {mod} has no function {fn or 'simulate'!r}")
+    return f
+
+
+def _not_converged(fit, max_iter: int) -> str:
+    """Why a fit is not one to use ("" when it is)."""
+    reasons = []
+    if not fit.converged:
+        reasons.append(f"the optimiser stopped after {fit.n_evaluations} evaluations (--max-iter {max_iter}) "
+                       "without meeting its tolerances; raise --max-iter")
+    if not fit.solver_converged:
+        reasons.append(f"the forward simulation at the fitted law did not reach equilibrium (residual "
+                       f"{float(max(fit.solver_residual, default=float('nan'))):.2e})")
+    return "; ".join(reasons)
 
 
 def main(argv=None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    """Run the fit; exit status 0 (fitted), 1 (a fit did not converge: params.json written with
+    ``converged: false`` and the reason; or it could not start: nothing written), 2 (refused input:
+    nothing written), 130 (interrupted, Ctrl-C: no params.json)."""
+    ap = argparse.ArgumentParser(prog=PROG, description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--profile", action="append", required=True, type=pathlib.Path, help="profile CSV (x_mm,z_mm)")
     ap.add_argument("--overhang-mm", action="append", required=True, type=float, help="overhang of each profile, mm")
     ap.add_argument("--areal-mass-gsm", required=True, type=float, help="areal mass, g/m²")
@@ -81,6 +122,7 @@ def main(argv=None) -> int:
                     help="seconds between progress lines when stderr is not a terminal (default 10)")
     args = ap.parse_args(argv)
 
+    # ----- the edge: every argument and every profile checked before anything is fitted or written
     if len(args.profile) != len(args.overhang_mm):
         ap.error(f"{len(args.profile)} --profile but {len(args.overhang_mm)} --overhang-mm: give one overhang per profile")
     sides = args.side or ["pos"]
@@ -88,12 +130,30 @@ def main(argv=None) -> int:
         sides = sides * len(args.profile)
     if len(sides) != len(args.profile):
         ap.error("--side: give it once (all profiles) or once per profile")
-    if args.areal_mass_gsm <= 0:
-        ap.error("--areal-mass-gsm must be > 0")
+    if not (math.isfinite(args.areal_mass_gsm) and args.areal_mass_gsm > 0):
+        ap.error(f"--areal-mass-gsm {args.areal_mass_gsm:g}: must be > 0 (g/m²)")
+    for L_mm in args.overhang_mm:
+        if not (math.isfinite(L_mm) and L_mm > 0):
+            ap.error(f"--overhang-mm {L_mm:g}: must be > 0 (the strip's free length, mm)")
+    if args.max_iter < 1:
+        ap.error(f"--max-iter {args.max_iter}: must be >= 1")
+    if not (math.isfinite(args.progress_every) and args.progress_every >= 0):
+        ap.error(f"--progress-every {args.progress_every:g}: must be >= 0 seconds")
+    if args.plot is not None and args.plot == args.out:
+        ap.error("--plot and --out must be different files")
     for path in (args.out, args.plot):
         if path is not None and path.exists() and not args.force:
             ap.error(f"{path} exists; refusing to overwrite it (pass --force)")
+    try:
+        return _run(args, sides)
+    except KeyboardInterrupt:
+        done = f"{args.out} was written before (the plot was not)" if args.out.exists() and getattr(args, "wrote_out", False) \
+            else f"{args.out} not written"
+        print(f"\n{PROG}: interrupted; {done}", file=sys.stderr)
+        return 130
 
+
+def _run(args, sides) -> int:
     import jax
 
     if not args.float32:
@@ -104,35 +164,45 @@ def main(argv=None) -> int:
     areal_mass = units.gsm_to_kg_per_m2(args.areal_mass_gsm)
     groups: dict[str, list] = {}
     try:
+        simulate = _simulate_from_spec(args.simulate)
         for path, L_mm, side in zip(args.profile, args.overhang_mm, sides):
-            if L_mm <= 0:
-                raise ValueError(f"--overhang-mm {L_mm}: must be > 0")
             L = units.mm_to_m(L_mm)
             x, z = cf.read_profile_csv(path, overhang=L)
             groups.setdefault(side, []).append(calibrate.Profile(x, z, L))
     except ValueError as err:
-        print(f"error: {err}", file=sys.stderr)
+        print(f"{PROG}: error: {err}", file=sys.stderr)
         return 2
-    simulate = _simulate_from_spec(args.simulate)
     t0 = time.perf_counter()
-    results, fits = {}, {}
+    results, fits, failed = {}, {}, {}
     for side, profs in groups.items():
         progress = _Progress(side, args.max_iter, args.progress_every)
-        fit = calibrate.fit_cantilever(profs, areal_mass=areal_mass, law=args.law, simulate=simulate,
-                                       compute_b41_5=not args.no_standard_test, max_iter=args.max_iter,
-                                       callback=progress)
+        try:
+            fit = calibrate.fit_cantilever(profs, areal_mass=areal_mass, law=args.law, simulate=simulate,
+                                           compute_b41_5=not args.no_standard_test, max_iter=args.max_iter,
+                                           callback=progress)
+        except RuntimeError as err:  # no starting point gave a finite, converged simulation
+            progress.abandon()
+            print(f"{PROG}: the fit [{side}] could not start: {err}; {args.out} not written", file=sys.stderr)
+            return 1
+        except BaseException:
+            progress.abandon()
+            raise
         progress.close(fit)
         fits[side] = fit
         d = fit.as_dict()
-        d.update(side=side, areal_mass_gsm=args.areal_mass_gsm,
+        reason = _not_converged(fit, args.max_iter)
+        d.update(converged=not reason, reason=reason, side=side, areal_mass_gsm=args.areal_mass_gsm,
                  profiles=[{"file": str(p), "overhang_mm": L} for p, L, s in zip(args.profile, args.overhang_mm, sides) if s == side])
+        if reason:
+            failed[side] = reason
         results[side] = d
     if len(results) == 1:
         out = next(iter(results.values()))
     else:
-        out = {"side": "both", **{s: results[s] for s in ("pos", "neg")}}
+        out = {"side": "both", "converged": not failed, **{s: results[s] for s in ("pos", "neg")}}
     out["total_wall_time_s"] = time.perf_counter() - t0
     cf.write_json(args.out, out, force=args.force)
+    args.wrote_out = True
     for side, d in results.items():
         det = "determined" if d["b_inf_determined"] else "UNDETERMINED (data do not reach 5 x kappa0)"
         print(f"[{side}] B_init {d['b_init_Nm']:.4g} ± {d['sigma_b_init_Nm']:.2g} N·m, "
@@ -147,7 +217,10 @@ def main(argv=None) -> int:
             path = args.plot if len(fits) == 1 else args.plot.with_name(f"{args.plot.stem}-{side}{args.plot.suffix}")
             pc.save(pc.cantilever_fit_figure(fit, groups[side], title=f"cantilever fit ({side})"), path)
             print(f"wrote {path}")
-    return 0
+    for side, reason in failed.items():
+        print(f"{PROG}: the fit [{side}] did not converge: {reason} ({args.out} records it: converged false)",
+              file=sys.stderr)
+    return 1 if failed else 0
 
 
 if __name__ == "__main__":

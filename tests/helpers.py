@@ -19,3 +19,76 @@ def central_difference(f, x, h, *, index=None, direction=None):
     plus = np.asarray(f(x + h * d), dtype=np.float64)
     minus = np.asarray(f(x - h * d), dtype=np.float64)
     return (plus - minus) / (2.0 * h)
+
+
+# ----- a small stand-in cantilever ------------------------------------------------------------
+# ``simulate_standin(law, overhang=, areal_mass=)`` has the signature of
+# ``jaxform.cantilever.simulate``: a discrete inextensible elastica (``n`` straight segments, angles
+# as unknowns) whose bending + gravitational energy is minimised by Newton's method with load
+# continuation, differentiable (forward and reverse mode) through the unrolled iterations. A test
+# double, not physics the package relies on (test_calibration.test_standin_matches_reference checks
+# it against the reference elastica). Command-line tests load it as
+# ``--simulate helpers:simulate_small`` with tests/ on the PYTHONPATH.
+
+import functools  # noqa: E402
+from typing import NamedTuple  # noqa: E402
+
+import jax  # noqa: E402
+import jax.numpy as jnp  # noqa: E402
+
+from jaxform.units import GRAVITY  # noqa: E402
+
+
+class StandinResult(NamedTuple):
+    x: jax.Array  # (n+1,) m, clamp to tip
+    z: jax.Array  # (n+1,) m, negative downwards
+    tip_angle: jax.Array  # rad
+
+
+@functools.partial(jax.jit, static_argnames=("overhang", "n", "steps", "newton"))
+def simulate_standin(law, *, overhang, areal_mass, n: int = 48, steps: int = 8, newton: int = 6):
+    h = overhang / n
+    w = areal_mass * GRAVITY
+
+    def energy(theta, lam):
+        # curvature at interior nodes (between segment midpoints, weight h) and at the clamp
+        # (from the clamped direction to the first midpoint, weight h/2): second order
+        kappa = jnp.diff(theta) / h
+        kappa_c = theta[0] / (0.5 * h)
+        z = jnp.concatenate([jnp.zeros(1, theta.dtype), -h * jnp.cumsum(jnp.sin(theta))])
+        bend = h * jnp.sum(law.energy(kappa)) + 0.5 * h * law.energy(kappa_c)
+        return bend + lam * w * h * jnp.sum(0.5 * (z[:-1] + z[1:]))
+
+    grad = jax.grad(energy)
+    hess = jax.hessian(energy)
+
+    def newton_step(theta, lam):
+        return theta - jnp.linalg.solve(hess(theta, lam), grad(theta, lam))
+
+    theta = jnp.zeros(n, jnp.result_type(float)) * law.b_init
+    for k in range(1, steps + 1):
+        lam = k / steps
+        theta = jax.lax.fori_loop(0, newton, lambda i, t: newton_step(t, lam), theta)
+    x = jnp.concatenate([jnp.zeros(1, theta.dtype), h * jnp.cumsum(jnp.cos(theta))])
+    z = jnp.concatenate([jnp.zeros(1, theta.dtype), -h * jnp.cumsum(jnp.sin(theta))])
+    return StandinResult(x=x, z=z, tip_angle=theta[-1])
+
+
+SMALL = functools.partial(simulate_standin, n=16, steps=4, newton=5)
+simulate_small = SMALL  # the command-line tests' MODULE:FUNCTION
+
+
+def simulate_interrupted(law, **kwargs):
+    """``simulate_small`` that first sends this process SIGINT, as Ctrl-C on a terminal does: the
+    command-line test of an interrupted fit, without racing a real keyboard."""
+    import os
+    import signal
+
+    os.kill(os.getpid(), signal.SIGINT)
+    return SMALL(law, **kwargs)
+
+
+def simulate_nan(law, *, overhang, areal_mass, **kwargs):
+    """A forward model that never gives a finite profile (a fit that cannot start)."""
+    out = SMALL(law, overhang=overhang, areal_mass=areal_mass)
+    return out._replace(z=out.z * jnp.nan)

@@ -1,26 +1,17 @@
 """Cantilever calibration: profile files, parameterisation, interpolation, the fit and its command.
 
-Fast tests use a small JAX stand-in of the cantilever (``simulate_standin`` below) so the fitting
-machinery is checked on its own; the acceptance round trips through jaxform.cantilever are in
-tests/test_calibration_cantilever.py (slow).
-
-``simulate_standin(law, overhang=, areal_mass=)`` has the signature of
-``jaxform.cantilever.simulate``: a discrete inextensible elastica (``n`` straight segments, angles
-as unknowns) whose bending + gravitational energy is minimised by Newton's method with load
-continuation, differentiable (forward and reverse mode) through the unrolled iterations. It is a
-test double, not physics the package relies on; ``test_standin_matches_reference`` checks it
-against the independent reference elastica (second-order convergence). The command-line test
-loads it as ``--simulate test_calibration:simulate_small`` (this module, on the PYTHONPATH).
+Fast tests use a small JAX stand-in of the cantilever (``helpers.simulate_standin``, a test double
+shared with the command-line tests) so the fitting machinery is checked on its own;
+``test_standin_matches_reference`` checks the stand-in against the independent reference elastica.
+The acceptance round trips through jaxform.cantilever are in tests/test_calibration_cantilever.py
+(slow).
 """
-import functools
 import json
 import os
 import pathlib
 import subprocess
 import sys
-from typing import NamedTuple
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 import pytest
@@ -28,7 +19,7 @@ import pytest
 from jaxform import calibrate as C
 from jaxform.io import calibration_files as cf
 from jaxform.materials import VoceBending
-from jaxform.units import GRAVITY
+from helpers import SMALL, simulate_standin
 from reference import elastica as E
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -36,46 +27,7 @@ TRUE = dict(b_inf=3e-5, m0=5e-3, kappa0=25.0)  # unlike the presets
 MASS = 0.21
 
 
-# ----- the stand-in cantilever ---------------------------------------------------------------
-
-
-class StandinResult(NamedTuple):
-    x: jax.Array  # (n+1,) m, clamp to tip
-    z: jax.Array  # (n+1,) m, negative downwards
-    tip_angle: jax.Array  # rad
-
-
-@functools.partial(jax.jit, static_argnames=("overhang", "n", "steps", "newton"))
-def simulate_standin(law, *, overhang, areal_mass, n: int = 48, steps: int = 8, newton: int = 6):
-    h = overhang / n
-    w = areal_mass * GRAVITY
-
-    def energy(theta, lam):
-        # curvature at interior nodes (between segment midpoints, weight h) and at the clamp
-        # (from the clamped direction to the first midpoint, weight h/2): second order
-        kappa = jnp.diff(theta) / h
-        kappa_c = theta[0] / (0.5 * h)
-        z = jnp.concatenate([jnp.zeros(1, theta.dtype), -h * jnp.cumsum(jnp.sin(theta))])
-        bend = h * jnp.sum(law.energy(kappa)) + 0.5 * h * law.energy(kappa_c)
-        return bend + lam * w * h * jnp.sum(0.5 * (z[:-1] + z[1:]))
-
-    grad = jax.grad(energy)
-    hess = jax.hessian(energy)
-
-    def newton_step(theta, lam):
-        return theta - jnp.linalg.solve(hess(theta, lam), grad(theta, lam))
-
-    theta = jnp.zeros(n, jnp.result_type(float)) * law.b_init
-    for k in range(1, steps + 1):
-        lam = k / steps
-        theta = jax.lax.fori_loop(0, newton, lambda i, t: newton_step(t, lam), theta)
-    x = jnp.concatenate([jnp.zeros(1, theta.dtype), h * jnp.cumsum(jnp.cos(theta))])
-    z = jnp.concatenate([jnp.zeros(1, theta.dtype), -h * jnp.cumsum(jnp.sin(theta))])
-    return StandinResult(x=x, z=z, tip_angle=theta[-1])
-
-
-SMALL = functools.partial(simulate_standin, n=16, steps=4, newton=5)
-simulate_small = SMALL  # the command-line test's MODULE:FUNCTION
+# ----- the stand-in cantilever (tests/helpers.py) ------------------------------------------
 
 
 @pytest.mark.parametrize("L", [0.1])
@@ -219,7 +171,7 @@ def test_fit_cantilever_command(tmp_path):
     env = dict(os.environ, PYTHONPATH=str(ROOT / "tests") + os.pathsep + os.environ.get("PYTHONPATH", ""))
     cmd = [sys.executable, str(ROOT / "calibration" / "fit_cantilever.py"), "--profile", str(csv), "--overhang-mm", "90",
            "--areal-mass-gsm", "210", "--out", str(out), "--plot", str(tmp_path / "fit.png"),
-           "--simulate", "test_calibration:simulate_small", "--no-standard-test", "--progress-every", "0"]
+           "--simulate", "helpers:simulate_small", "--no-standard-test", "--progress-every", "0"]
     r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=env)
     assert r.returncode == 0, r.stderr
     # progress: stderr is a pipe here, so plain lines, one per optimiser iteration, then a summary

@@ -1,0 +1,139 @@
+"""calibration/fit_cantilever.py: no plausible wrong answer with exit 0 (issue 14 item 8).
+
+Input is refused at the edge (exit 2, ``fit_cantilever.py: error: ...``, nothing written); a fit
+that did not converge exits 1 with the reason on screen and in params.json; Ctrl-C exits 130 with
+a message and no params.json. The forward model is the small stand-in ``helpers:simulate_small``.
+"""
+import importlib.util
+import json
+import os
+import pathlib
+import re
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from jaxform.io import calibration_files as cf
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+SCRIPT = ROOT / "calibration" / "fit_cantilever.py"
+ENV = dict(os.environ, PYTHONPATH=str(ROOT / "tests") + os.pathsep + os.environ.get("PYTHONPATH", ""))
+
+
+def _main():
+    spec = importlib.util.spec_from_file_location("fit_cantilever_script", SCRIPT)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod.main
+
+
+def _cli(argv, capsys):
+    """Run the script in-process → (exit status, stdout, stderr)."""
+    try:
+        rc = _main()([str(a) for a in argv])
+    except SystemExit as err:  # argparse's refusals
+        rc = err.code
+    out, err = capsys.readouterr()
+    return rc, out, err
+
+
+def _profile_rows(n=40, L_mm=90.0):
+    """A plausible hanging profile (mm): a drooping curve reaching 80 % of the overhang."""
+    x = np.linspace(0.0, 0.8 * L_mm, n)
+    return x, -0.45 * L_mm * (x / x[-1]) ** 2
+
+
+def _write(path, x, z):
+    path.write_text("x_mm,z_mm\n" + "\n".join(f"{a:.6f},{b:.6f}" for a, b in zip(x, z)) + "\n")
+    return path
+
+
+def _args(profile, out, *extra, overhang="90"):
+    return ["--profile", profile, "--overhang-mm", overhang, "--areal-mass-gsm", "210", "--out", out,
+            "--no-standard-test", "--progress-every", "0", "--simulate", "helpers:simulate_small", *extra]
+
+
+@pytest.mark.parametrize("case,match", [
+    ("metres", r"spans only 0.072 mm .* under 1 % of the 90 mm overhang; .* looks like a profile in metres"),
+    ("nan_rows", r"2 rows with a missing or non-numeric value in x_mm,z_mm \(lines 5, 9\)"),
+    ("overhang", r"--overhang-mm -90: must be > 0"),
+    ("mass", r"--areal-mass-gsm 0: must be > 0"),
+    ("max_iter", r"--max-iter 0: must be >= 1"),
+    ("simulate", r"--simulate helpers:no_such_model: helpers has no function 'no_such_model'"),
+])
+def test_fit_cantilever_refuses_input(tmp_path, capsys, case, match):
+    x, z = _profile_rows()
+    p = _write(tmp_path / "p.csv", x, z)
+    extra, overhang = [], "90"
+    if case == "metres":  # the same profile in metres, in the mm file: used to be fitted, exit 0
+        p = _write(tmp_path / "p.csv", x * 1e-3, z * 1e-3)
+    elif case == "nan_rows":  # used to be dropped silently
+        rows = p.read_text().splitlines()
+        rows[4], rows[8] = rows[4].split(",")[0] + ",nan", "," + rows[8].split(",")[1]
+        p.write_text("\n".join(rows) + "\n")
+    elif case == "overhang":
+        overhang = "-90"
+    elif case == "mass":
+        extra = ["--areal-mass-gsm", "0"]
+    elif case == "max_iter":
+        extra = ["--max-iter", "0"]
+    elif case == "simulate":
+        extra = ["--simulate", "helpers:no_such_model"]
+    out = tmp_path / "params.json"
+    rc, stdout, err = _cli(_args(p, out, *extra, overhang=overhang), capsys)
+    assert rc == 2, (stdout, err)
+    assert "fit_cantilever.py: error: " in err and "Traceback" not in err
+    assert re.search(match, err), err
+    assert not out.exists()
+
+
+def test_fit_cantilever_unconverged_fit_exits_nonzero(tmp_path, capsys):
+    """Two optimiser evaluations cannot converge: exit 1, the reason on stderr and in params.json."""
+    x, z = _profile_rows()
+    p = _write(tmp_path / "p.csv", x, z)
+    out = tmp_path / "params.json"
+    rc, stdout, err = _cli(_args(p, out, "--max-iter", "2"), capsys)
+    assert rc == 1, (stdout, err)
+    assert "fit_cantilever.py: the fit [pos] did not converge: the optimiser stopped after" in err
+    assert "fit [pos] done:" in err  # the progress lines stay
+    d = json.loads(out.read_text())
+    assert d["converged"] is False and "--max-iter 2" in d["reason"]
+    assert np.isfinite(d["b_init_Nm"])
+
+
+def test_fit_cantilever_that_cannot_start_writes_nothing(tmp_path, capsys):
+    x, z = _profile_rows()
+    p = _write(tmp_path / "p.csv", x, z)
+    out = tmp_path / "params.json"
+    rc, stdout, err = _cli(_args(p, out, "--simulate", "helpers:simulate_nan"), capsys)
+    assert rc == 1 and "could not start" in err and "Traceback" not in err
+    assert not out.exists()
+
+
+def test_fit_cantilever_ctrl_c(tmp_path):
+    """SIGINT (Ctrl-C) during the fit: a message, exit 130, no params.json, no traceback."""
+    x, z = _profile_rows()
+    p = _write(tmp_path / "p.csv", x, z)
+    out = tmp_path / "params.json"
+    cmd = [sys.executable, str(SCRIPT), *map(str, _args(p, out, "--simulate", "helpers:simulate_interrupted"))]
+    r = subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT, env=ENV, timeout=600)
+    assert r.returncode == 130, r.stderr
+    assert "fit_cantilever.py: interrupted;" in r.stderr and "not written" in r.stderr
+    assert "Traceback" not in r.stderr
+    assert not out.exists() and not list(tmp_path.glob(".*tmp"))
+
+
+def test_write_json_leaves_no_partial_file(tmp_path, monkeypatch):
+    """params.json is written whole (temporary file + rename): an interrupted write leaves nothing."""
+    path = tmp_path / "params.json"
+
+    def boom(self, text, *a, **k):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(pathlib.Path, "write_text", boom)
+    with pytest.raises(KeyboardInterrupt):
+        cf.write_json(path, {"b_init_Nm": 1.0})
+    monkeypatch.undo()
+    assert not path.exists() and list(tmp_path.iterdir()) == []

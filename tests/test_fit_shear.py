@@ -1,5 +1,8 @@
 """Shear-law fit (jaxform.calibrate.fit_shear_*) and calibration/fit_shear.py."""
+import importlib.util
+import json
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -99,8 +102,6 @@ def test_fit_shear_command_raw_frame_data(tmp_path):
 
 
 def _fit_shear_main():
-    import importlib.util
-
     spec = importlib.util.spec_from_file_location("fit_shear_script", ROOT / "calibration" / "fit_shear.py")
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
@@ -181,7 +182,7 @@ def test_fit_shear_command_refuses_input(tmp_path, capsys, case, match):
     rc, out, err = _cli(["--data", data, *extra, "--out", outs[0], "--json", outs[1], "--plot", outs[2]], capsys)
     assert rc == 2, (out, err)
     assert "fit_shear.py: error: " in err and "Traceback" not in err
-    assert __import__("re").search(match, err), err
+    assert re.search(match, err), err
     assert not any(p.exists() for p in outs)
 
 
@@ -193,7 +194,7 @@ def test_fit_shear_command_unconverged_fit_is_not_success(tmp_path, capsys):
     rc, out, err = _cli(["--data", data, "--frame-side-mm", 145, "--degree", 1, "--out", toml, "--json", js], capsys)
     assert rc == 1
     assert "fit_shear.py: the fit did not converge: rmse" in err and "far above the data's scatter" in err
-    d = __import__("json").loads(js.read_text())
+    d = json.loads(js.read_text())
     assert d["converged"] is False and "far above the data's scatter" in d["reason"]
     assert "converged = false" in toml.read_text() and "NOT A VALID FIT" in toml.read_text()
     with pytest.raises(ValueError, match="did not converge"):

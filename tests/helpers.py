@@ -1,4 +1,5 @@
-"""Helpers shared by the tests (not a test module): the one finite-difference derivative."""
+"""Helpers shared by the tests (not a test module): the one finite-difference derivative, and
+small stand-in cantilever models that the calibration scripts load with ``--simulate helpers:NAME``."""
 import numpy as np
 
 

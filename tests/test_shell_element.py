@@ -9,6 +9,9 @@ from jaxform.mesh import Mesh
 from jaxform.shell import (Shell, _shear_energy, energy, energy_parts, fibre_curvatures, forces, shear_angle,
                            fibre_vectors, shear_resultant)
 
+# jitted once per module: op-by-op (eager) evaluation of the element kernel costs tens of seconds
+forces, energy = jax.jit(forces), jax.jit(energy)
+
 
 def _curved_sheared_mesh():
     """A cylindrical-ish, doubly curved patch meshed with a skewed (sheared) grid: stress-free reference."""
@@ -153,9 +156,11 @@ def test_symmetric_hessian_reverse_mode_equals_plain_autodiff(fabric):
         return jnp.sum(out * r) + sum(c[k] * parts[k] for k in c)
 
     args = (xs, shell.fabrics[0])
-    plain = jax.grad(lambda x, fb: loss(forces_and_energy_soa, x, fb), argnums=(0, 1))(*args)
+    # jitted: op-by-op (eager) reverse mode through the element kernel costs minutes of dispatch
+    plain = jax.jit(jax.grad(lambda x, fb: loss(forces_and_energy_soa, x, fb), argnums=(0, 1)))(*args)
     x_ref = jnp.asarray(mesh.nodes).T  # the integrator's kernel takes displacements from the mesh
-    sym = jax.grad(lambda x, fb: loss(lambda y, sh: forces_and_energy_sym(y - x_ref, sh), x, fb), argnums=(0, 1))(*args)
+    sym = jax.jit(jax.grad(lambda x, fb: loss(lambda y, sh: forces_and_energy_sym(y - x_ref, sh), x, fb),
+                           argnums=(0, 1)))(*args)
     for a, b in zip(jax.tree_util.tree_leaves(plain), jax.tree_util.tree_leaves(sym)):
         a, b = np.asarray(a), np.asarray(b)
         np.testing.assert_allclose(b, a, rtol=1e-10, atol=1e-12 * max(np.max(np.abs(a)), 1e-300))

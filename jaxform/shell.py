@@ -45,7 +45,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
-from jaxform.geometry import safe_sqrt
+from jaxform.geometry import tiny_sqrt
 from jaxform.mesh import Mesh
 
 SHEAR_READINGS = ("a14", "conjugate")
@@ -135,8 +135,8 @@ def _cross(a, b):
 
 
 def _norm(v):
-    """Norm of SoA vectors (3, ...): geometry's safe_sqrt of the kernels' dot (zero gradient at 0)."""
-    return safe_sqrt(_dot(v, v))
+    """Norm of SoA vectors (3, ...): geometry's tiny_sqrt of the kernels' dot (cheap in the hot loop)."""
+    return tiny_sqrt(_dot(v, v))
 
 
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on

@@ -95,7 +95,7 @@ def _definitions(pattern):
 
 def test_one_home_for_gravity_and_safe_maths():
     assert _definitions(r"^GRAVITY\s*=") == ["jaxform.units"]
-    assert _definitions(r"^def (safe_norm|_safe_norm|safe_sqrt|_safe_sqrt)\b") == ["jaxform.geometry"]
+    assert _definitions(r"^def (safe_norm|_safe_norm|safe_sqrt|_safe_sqrt|tiny_sqrt)\b") == ["jaxform.geometry"]
     assert _definitions(r"^def (closest_point_triangle|point_triangle_sqdist)\b") == ["jaxform.geometry"]
 
 

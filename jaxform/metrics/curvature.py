@@ -285,7 +285,7 @@ def _fit(d, w, n, h):
     return coef * scale, e1, e2
 
 
-def curvatures_from_stencil(nodes, stencil: CurvatureStencil, *, max_iter: int = 10,
+def _curvatures_from_stencil(nodes, stencil: CurvatureStencil, *, max_iter: int = 10,
                             tol: float | None = None):
     """Principal curvatures from a precomputed stencil (pure JAX; see the module docstring).
 
@@ -354,7 +354,8 @@ def curvatures_from_stencil(nodes, stencil: CurvatureStencil, *, max_iter: int =
     return H + root, H - root
 
 
-_curvatures_jit = jax.jit(curvatures_from_stencil, static_argnames=("max_iter", "tol"))
+curvatures_from_stencil = jax.jit(_curvatures_from_stencil, static_argnames=("max_iter", "tol"))
+curvatures_from_stencil.__doc__ = _curvatures_from_stencil.__doc__  # compiled once per mesh shape: call it per frame
 
 
 def principal_curvatures(nodes, faces, *, max_iter: int = 10, tol: float | None = None,
@@ -386,7 +387,7 @@ def principal_curvatures(nodes, faces, *, max_iter: int = 10, tol: float | None 
                 )
     n_nodes = nodes.shape[0]
     st = curvature_stencil(faces, n_nodes, rings=rings, check=check)
-    return _curvatures_jit(nodes, st, max_iter=max_iter, tol=tol)
+    return curvatures_from_stencil(nodes, st, max_iter=max_iter, tol=tol)
 
 
 def kappa_max(k1, k2):

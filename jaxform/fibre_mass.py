@@ -56,7 +56,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
-from jaxform.shell import Shell, _corner_ids, _dot, _edges, _fibres_soa, _norm, membrane_frequency
+from jaxform.shell import Shell, _corner_ids, _dot, _edges, _fibres_soa, _stretch, membrane_frequency
 
 ETA = 0.05  # Chebyshev damping: keeps q > 0 (undamped, q has zeros: modes of infinite mass)
 
@@ -175,7 +175,7 @@ def fibre_units(xs, shell: Shell):
     """Unit current fibre directions per triangle at positions ``xs`` (3, N): two (3, T) arrays."""
     e1, e2 = _edges(xs, shell.mesh)
     g1, g2 = _fibres_soa(e1, e2, shell.ref.tri_coef.astype(xs.dtype))
-    return g1 / _norm(g1), g2 / _norm(g2)
+    return g1 / _stretch(g1), g2 / _stretch(g2)
 
 
 def stretch_rates(vs, units, shell: Shell):

@@ -22,19 +22,17 @@ the hyperelastic energy whose derivative is that resultant is
 (so forces are exact gradients and energy is conserved); the resultant conjugate to ``gamma`` is
 ``dW_s/dgamma = T(gamma)``, exactly the rate form's stress integrated along a monotone path. The
 option ``shear_reading="conjugate"`` reads ``F_norm`` itself as the force conjugate to ``gamma``
-(``W_s = law.integral(gamma)``, the picture-frame normalisation of e.g. Harrison et al.). The
-picture-frame rig (:mod:`jaxform.frame_tests`) and its test check the simulated frame force
-against the closed form implied by each reading.
+(``W_s = law.integral(gamma)``, the picture-frame normalisation of e.g. Harrison et al.). The frame
+rig (:mod:`jaxform.frame_tests`) checks the simulated frame force against each reading's closed form.
 
-Bending (per node; decoupled from the membrane as in the paper's laminate shell): with the node's
-generalised finite-difference weights (:mod:`jaxform.mesh`), ``x_X, x_Y, x_XX, x_XY, x_YY`` at the
-node, the reference fibre direction ``d = (c, s)`` in the node frame, ``x_d = c x_X + s x_Y``,
-``x_dd = c^2 x_XX + 2cs x_XY + s^2 x_YY``, the unit normal ``n = x_X x x_Y / |.|`` and the fibre's
-normal curvature ``kappa_f = -n . x_dd / |x_d|^2`` (positive when the fibre bends away from ``n``,
-SPEC section 2). Energy ``sum_nodes A_node sum_f W_f(kappa_f - kappa0_f)`` with ``W_f`` the law's
-``energy`` (its derivative is the moment ``M(kappa)``, asymmetric laws included), ``kappa0`` the
-reference curvature (zero for flat blanks). Because ``d`` is a material direction and ``x_dd``
-the second derivative along it, the bending follows the sheared fibres.
+Bending (per node; decoupled from the membrane): with the node's generalised finite-difference
+weights (:mod:`jaxform.mesh`), ``x_X, x_Y, x_XX, x_XY, x_YY`` at the node, the reference fibre
+direction ``d = (c, s)`` in the node frame, ``x_d = c x_X + s x_Y``, ``x_dd = c^2 x_XX + 2cs x_XY +
+s^2 x_YY``, the unit normal ``n = x_X x x_Y / |.|`` and the fibre's normal curvature ``kappa_f = -n
+. x_dd / |x_d|^2`` (positive when the fibre bends away from ``n``, SPEC section 2). Energy
+``sum_nodes A_node sum_f W_f(kappa_f - kappa0_f)`` with ``W_f`` the law's ``energy`` (derivative:
+the moment ``M(kappa)``; asymmetric laws too), ``kappa0`` the reference curvature (zero for flat
+blanks). ``d`` is a material direction: the bending follows the sheared fibres.
 """
 from __future__ import annotations
 
@@ -135,14 +133,12 @@ def _cross(a, b):
 
 
 def _norm(v):
-    """Norm of SoA vectors (3, ...) that may vanish (normals, cross products): geometry's safe_sqrt,
-    zero first and second derivatives at 0 (the static solver's Newton steps need them finite)."""
+    """Norm of SoA vectors (3, ...) that may vanish: safe_sqrt (finite derivatives for Newton at 0)."""
     return safe_sqrt(_dot(v, v))
 
 
 def _stretch(g):
-    """Length of SoA fibre vectors (3, ...), about 1, never 0: geometry's tiny_sqrt, one fused op
-    (the select of safe_sqrt on these per-triangle lengths cost the explicit step ~30%)."""
+    """Length of SoA fibre vectors (3, ...), ~1: tiny_sqrt, one fused op (safe_sqrt costs the step 30%)."""
     return tiny_sqrt(_dot(g, g))
 
 

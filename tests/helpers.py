@@ -93,3 +93,20 @@ def simulate_nan(law, *, overhang, areal_mass, **kwargs):
     """A forward model that never gives a finite profile (a fit that cannot start)."""
     out = SMALL(law, overhang=overhang, areal_mass=areal_mass)
     return out._replace(z=out.z * jnp.nan)
+
+
+def run_calibration_script(name, argv, capsys):
+    """Run ``calibration/<name>.py``'s ``main`` in-process -> (exit status, stdout, stderr)."""
+    import importlib.util
+    import pathlib
+
+    path = pathlib.Path(__file__).resolve().parents[1] / "calibration" / f"{name}.py"
+    spec = importlib.util.spec_from_file_location(f"{name}_script", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    try:
+        rc = mod.main([str(a) for a in argv])
+    except SystemExit as err:  # argparse's refusals
+        rc = err.code
+    out, err = capsys.readouterr()
+    return rc, out, err

@@ -4,7 +4,6 @@ Input is refused at the edge (exit 2, ``fit_cantilever.py: error: ...``, nothing
 that did not converge exits 1 with the reason on screen and in params.json; Ctrl-C exits 130 with
 a message and no params.json. The forward model is the small stand-in ``helpers:simulate_small``.
 """
-import importlib.util
 import json
 import os
 import pathlib
@@ -16,27 +15,15 @@ import numpy as np
 import pytest
 
 from jaxform.io import calibration_files as cf
+from helpers import run_calibration_script
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "calibration" / "fit_cantilever.py"
 ENV = dict(os.environ, PYTHONPATH=str(ROOT / "tests") + os.pathsep + os.environ.get("PYTHONPATH", ""))
 
 
-def _main():
-    spec = importlib.util.spec_from_file_location("fit_cantilever_script", SCRIPT)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod.main
-
-
 def _cli(argv, capsys):
-    """Run the script in-process → (exit status, stdout, stderr)."""
-    try:
-        rc = _main()([str(a) for a in argv])
-    except SystemExit as err:  # argparse's refusals
-        rc = err.code
-    out, err = capsys.readouterr()
-    return rc, out, err
+    return run_calibration_script("fit_cantilever", argv, capsys)
 
 
 def _profile_rows(n=40, L_mm=90.0):

@@ -44,4 +44,6 @@ def test_every_example_has_its_numbers_checked():
 def test_example_prints_its_numbers(path, capsys, monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
     runpy.run_path(str(path), run_name="__main__")
-    CHECKS[path.name](capsys.readouterr().out)
+    out = capsys.readouterr().out
+    assert out.strip(), f"{path.name} printed nothing"
+    CHECKS[path.name](out)

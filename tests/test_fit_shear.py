@@ -1,5 +1,4 @@
 """Shear-law fit (jaxform.calibrate.fit_shear_*) and calibration/fit_shear.py."""
-import importlib.util
 import json
 import pathlib
 import re
@@ -12,6 +11,7 @@ import pytest
 from jaxform import calibrate as C
 from jaxform.io import calibration_files as cf
 from jaxform.materials import NCF_FCIM359, WOVEN_38616
+from helpers import run_calibration_script
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 
@@ -101,21 +101,8 @@ def test_fit_shear_command_raw_frame_data(tmp_path):
 # ----- no plausible wrong answer with exit 0 (issue 14 item 3) ---------------------------------
 
 
-def _fit_shear_main():
-    spec = importlib.util.spec_from_file_location("fit_shear_script", ROOT / "calibration" / "fit_shear.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod.main
-
-
 def _cli(argv, capsys):
-    """Run calibration/fit_shear.py in-process → (exit status, stdout, stderr)."""
-    try:
-        rc = _fit_shear_main()([str(a) for a in argv])
-    except SystemExit as err:  # argparse's refusals
-        rc = err.code
-    out, err = capsys.readouterr()
-    return rc, out, err
+    return run_calibration_script("fit_shear", argv, capsys)
 
 
 def _woven_rows(n=40, deg_max=55):

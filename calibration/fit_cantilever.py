@@ -14,7 +14,8 @@ only) and params.json holds ``pos`` and ``neg`` sections. Gravity 9.81 m/s².
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm`` (= b_inf + m0/kappa0),
 ``b_41_5_Nm`` (standard test simulated with the fitted law), ``rmse_mm`` (RMS z-residual at the
 measured x), ``sigma_*`` (Gauss–Newton standard errors), ``kappa_max_over_kappa0`` and
-``b_inf_determined``, ``iterations``, ``wall_time_s``. An existing --out is never overwritten
+``b_inf_determined`` (Fisher sd of B_inf under 10 % and the data past 5 kappa0), ``noise_mm`` (read
+off the profile) and ``rmse_over_noise``, ``iterations``, ``wall_time_s``. An existing --out is never overwritten
 without --force.
 
 Progress goes to stderr, one update per optimiser iteration: a tqdm bar on a terminal, plain
@@ -23,8 +24,10 @@ lines (at most one every ``--progress-every`` seconds, and the last) when stderr
 Input is checked before anything is fitted, and refused (``fit_cantilever.py: error: ...``, exit
 2, nothing written): an overhang or areal mass that is not > 0, a profile with missing values (the
 lines are named), a profile that spans under 1 % of its overhang (metres in the mm file), and
-what :func:`jaxform.io.calibration_files.read_profile_csv` refuses. A fit that did not converge
-writes params.json with ``converged: false`` and the ``reason``, says why on stderr and exits 1;
+what :func:`jaxform.io.calibration_files.read_profile_csv` refuses. A fit that is not to be used
+(the optimiser did not converge, the fitted strip is not an equilibrium, or its rmse is over twice
+the noise read off the profile: no Voce law reproduces it) writes params.json with ``converged:
+false`` and the ``reason``, says why on stderr (and in the plot's title) and exits 1;
 Ctrl-C stops with a message, no params.json, exit 130.
 """
 from __future__ import annotations
@@ -34,6 +37,7 @@ import importlib
 import math
 import pathlib
 import sys
+import textwrap
 import time
 
 
@@ -89,15 +93,12 @@ def _simulate_from_spec(spec: str):
 
 
 def _not_converged(fit, max_iter: int) -> str:
-    """Why a fit is not one to use ("" when it is)."""
-    reasons = []
-    if not fit.converged:
-        reasons.append(f"the optimiser stopped after {fit.n_evaluations} evaluations (--max-iter {max_iter}) "
-                       "without meeting its tolerances; raise --max-iter")
-    if not fit.solver_converged:
-        reasons.append(f"the forward simulation at the fitted law did not reach equilibrium (residual "
-                       f"{float(max(fit.solver_residual, default=float('nan'))):.2e})")
-    return "; ".join(reasons)
+    """Why a fit is not one to use ("" when it is): the fit's own verdict (optimiser, equilibrium,
+    rmse against the profile's noise), with the option that gives the optimiser more room."""
+    if fit.trustworthy:
+        return ""
+    hint = f" (--max-iter {max_iter}; raise it)" if not fit.converged else ""
+    return fit.reason + hint
 
 
 def main(argv=None) -> int:
@@ -204,10 +205,12 @@ def _run(args, sides) -> int:
     cf.write_json(args.out, out, force=args.force)
     args.wrote_out = True
     for side, d in results.items():
-        det = "determined" if d["b_inf_determined"] else "UNDETERMINED (data do not reach 5 x kappa0)"
+        det = "determined" if d["b_inf_determined"] else \
+            "UNDETERMINED: its Fisher sd is over 10 % or the data do not reach 5 x kappa0"
         print(f"[{side}] B_init {d['b_init_Nm']:.4g} ± {d['sigma_b_init_Nm']:.2g} N·m, "
               f"B_inf {d['b_inf_Nm']:.4g} ± {d['sigma_b_inf_Nm']:.2g} N·m ({det}), "
-              f"kappa0 {d['kappa0_per_m']:.4g} 1/m, rmse {d['rmse_mm']:.3f} mm, "
+              f"kappa0 {d['kappa0_per_m']:.4g} 1/m, rmse {d['rmse_mm']:.3f} mm ({d['rmse_over_noise']:.2f} x the noise "
+              f"{d['noise_mm']:.3f} mm read off the profile), "
               f"{d['iterations']} iterations, {d['wall_time_s']:.1f} s")
     print(f"wrote {args.out}")
     if args.plot is not None:
@@ -215,10 +218,12 @@ def _run(args, sides) -> int:
 
         for side, fit in fits.items():
             path = args.plot if len(fits) == 1 else args.plot.with_name(f"{args.plot.stem}-{side}{args.plot.suffix}")
-            pc.save(pc.cantilever_fit_figure(fit, groups[side], title=f"cantilever fit ({side})"), path)
+            title = f"cantilever fit ({side})" if side not in failed else \
+                f"cantilever fit ({side}) NOT TRUSTWORTHY: {textwrap.shorten(failed[side], 150)}"
+            pc.save(pc.cantilever_fit_figure(fit, groups[side], title=title), path)
             print(f"wrote {path}")
     for side, reason in failed.items():
-        print(f"{PROG}: the fit [{side}] did not converge: {reason} ({args.out} records it: converged false)",
+        print(f"{PROG}: the fit [{side}] failed: {reason} ({args.out} records it: converged false)",
               file=sys.stderr)
     return 1 if failed else 0
 

@@ -1,8 +1,9 @@
 """calibration/fit_cantilever.py: no plausible wrong answer with exit 0 (issue 14 item 8).
 
 Input is refused at the edge (exit 2, ``fit_cantilever.py: error: ...``, nothing written); a fit
-that did not converge exits 1 with the reason on screen and in params.json; Ctrl-C exits 130 with
-a message and no params.json. The forward model is the small stand-in ``helpers:simulate_small``.
+that did not converge, or whose rmse is far above the noise read off the profile (a profile no
+Voce law produces), exits 1 with the reason on screen, in params.json and in the plot's
+title; Ctrl-C exits 130 with a message and no params.json. The forward model is the small stand-in ``helpers:simulate_small``.
 """
 import json
 import os
@@ -10,12 +11,15 @@ import pathlib
 import re
 import subprocess
 import sys
+from typing import NamedTuple
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
+from jaxform.calibrate import interp_profile
 from jaxform.io import calibration_files as cf
-from helpers import run_calibration_script
+from helpers import run_calibration_script, simulate_small
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 SCRIPT = ROOT / "calibration" / "fit_cantilever.py"
@@ -83,11 +87,56 @@ def test_fit_cantilever_unconverged_fit_exits_nonzero(tmp_path, capsys):
     out = tmp_path / "params.json"
     rc, stdout, err = _cli(_args(p, out, "--max-iter", "2"), capsys)
     assert rc == 1, (stdout, err)
-    assert "fit_cantilever.py: the fit [pos] did not converge: the optimiser stopped after" in err
+    assert "fit_cantilever.py: the fit [pos] failed: the optimiser stopped after" in err
     assert "fit [pos] done:" in err  # the progress lines stay
     d = json.loads(out.read_text())
     assert d["converged"] is False and "--max-iter 2" in d["reason"]
     assert np.isfinite(d["b_init_Nm"])
+
+
+class _PlateauLaw(NamedTuple):
+    """M = B k up to k1, a plateau (slope eps B) to k2, then stiff again (B): no Voce law has that shape."""
+
+    B: float
+    k1: float
+    k2: float
+    eps: float = 0.02
+
+    @property
+    def b_init(self):
+        return self.B
+
+    def energy(self, k):
+        a, B = jnp.abs(k), self.B
+        a2 = jnp.clip(a - self.k1, 0.0, self.k2 - self.k1)
+        a3 = jnp.clip(a - self.k2, 0.0, None)
+        m2 = B * self.k1 + self.eps * B * (self.k2 - self.k1)
+        return 0.5 * B * jnp.minimum(a, self.k1) ** 2 + B * self.k1 * a2 + 0.5 * self.eps * B * a2**2 + m2 * a3 + 0.5 * B * a3**2
+
+
+def test_fit_cantilever_profile_no_voce_law_produces_exits_1(tmp_path, capsys, monkeypatch):
+    """Issue 18, done-when 3: a profile from a law with a plateau (then stiff again), made by the same
+    stand-in model the fit uses (so only the law's shape can be at fault), 0.05 mm noise: the best
+    Voce law misses it by many times the noise read off the profile. Exit 1, the reason on stderr,
+    in params.json and in the plot's title."""
+    L, mass = 0.09, 0.21
+    out = simulate_small(_PlateauLaw(3e-4, 5.0, 20.0), overhang=L, areal_mass=mass)
+    xq = np.linspace(0.02, 0.995, 40) * float(out.x[-1])
+    zq = np.asarray(interp_profile(jnp.asarray(xq), out.x, out.z)) + np.random.default_rng(0).normal(0, 5e-5, xq.size)
+    p = _write(tmp_path / "p.csv", 1e3 * xq, 1e3 * zq)
+    titles = []
+    from jaxform.plots import calibration as pc
+
+    real = pc.cantilever_fit_figure
+    monkeypatch.setattr(pc, "cantilever_fit_figure", lambda *a, **k: titles.append(k["title"]) or real(*a, **k))
+    res = tmp_path / "params.json"
+    rc, stdout, err = _cli(_args(p, res, "--plot", tmp_path / "fit.png"), capsys)
+    assert rc == 1, (stdout, err)
+    assert "fit_cantilever.py: the fit [pos] failed: rmse" in err and "no law of this kind reproduces the profile" in err
+    d = json.loads(res.read_text())
+    assert d["converged"] is False and "x the profile's noise" in d["reason"] and d["rmse_over_noise"] > 5
+    assert 0.6 < d["noise_mm"] / 0.05 < 1.4  # read off the profile
+    assert titles and "NOT TRUSTWORTHY" in titles[0] and (tmp_path / "fit.png").exists()
 
 
 def test_fit_cantilever_that_cannot_start_writes_nothing(tmp_path, capsys):

@@ -1,7 +1,8 @@
 """Calibration: fit bending laws to cantilever side profiles and shear laws to picture-frame data.
 
 Pure functions on arrays (no files, no printing): :mod:`~jaxform.calibrate.transforms` (the
-unconstrained law parameters), :mod:`~jaxform.calibrate.cantilever_fit` (bending laws through the
+law parameters and the strips' similarity), :mod:`~jaxform.calibrate.cantilever_data` (noise, bending
+length and clamp moment read off a profile), :mod:`~jaxform.calibrate.cantilever_fit` (bending laws through the
 shell cantilever, on ``scipy.optimize.least_squares``) and :mod:`~jaxform.calibrate.shear_fit`
 (shear laws, checked on the shell's picture frame). The scripts in ``calibration/`` and the readers
 in :mod:`jaxform.io.calibration_files` sit on top. SI units throughout.
@@ -12,7 +13,9 @@ from jaxform.calibrate.cantilever_fit import (
     CantileverFit,
     FitProgress,
     Profile,
+    bounds,
     discrete_curvature,
+    estimate_noise,
     fit_cantilever,
     initial_guess,
     interp_profile,
@@ -32,7 +35,7 @@ from jaxform.units import GRAVITY
 
 __all__ = [
     "GRAVITY", "Profile", "CantileverFit", "FitProgress", "ShearFit", "law_from_q", "q_from_law", "interp_profile",
-    "discrete_curvature", "peirce_b", "initial_guess", "fit_cantilever", "standard_test", "chord_angle",
+    "discrete_curvature", "peirce_b", "initial_guess", "bounds", "estimate_noise", "fit_cantilever", "standard_test", "chord_angle",
     "fit_shear_polynomial", "fit_shear_ncf", "picture_frame_normalised_force", "picture_frame_shear_angle",
     "check_shear_fit",
 ]

@@ -1,14 +1,21 @@
-"""Unconstrained parameters of the bending laws a cantilever fit varies.
+"""Parameters of the bending laws a cantilever fit varies, and the similarity of hanging strips.
 
-``q = (log B_init, log kappa0, logit(b_inf / B_init))`` for the Voce law, so that every ``q`` is a
-physical law (``b_inf >= 0``, ``m0 = (B_init - b_inf) kappa0 >= 0``, ``kappa0 > 0``) and the
-directions are well conditioned; ``q = (log B,)`` for the linear law.
+``q = (log B_init, log(b_inf / B_init), log kappa0)`` for the Voce law: ``B_init`` (what a profile
+determines best), the softening ratio ``B_inf / B_init`` in (0, 1] and the curvature scale. Every
+``q`` with ``q[1] <= 0`` is a physical law (``b_inf > 0``, ``m0 = (B_init - b_inf) kappa0 >= 0``,
+``kappa0 > 0``); the fit bounds the coordinates (``scipy.optimize.least_squares`` bounds) instead
+of letting ``b_inf`` run to zero in an unbounded log. ``q = (log B,)`` for the linear law.
+
+Similarity: an inextensible strip of overhang ``L`` under ``w`` with the law ``M(kappa)`` has the
+profile of a strip of overhang ``L' = s L`` under the same ``w`` with ``M'(kappa') = s^2 M(kappa'
+s)``, scaled by ``1/s`` (moments ``w L^2``, curvatures ``1/L``). For the Voce law ``b_inf' = s^3
+b_inf``, ``m0' = s^2 m0``, ``kappa0' = kappa0 / s``; :func:`law_from_q` with ``length_scale = s``
+gives that law, so a fit solves every overhang on one strip (one compile).
 """
 from __future__ import annotations
 
 import math
 
-import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -17,22 +24,22 @@ from jaxform.materials import LinearBending, VoceBending
 LAW_KINDS = ("voce", "linear")
 
 
-def law_from_q(q, law_kind: str):
-    """The bending law for unconstrained parameters ``q`` (module docstring); jit-able."""
+def law_from_q(q, law_kind: str, length_scale=1.0):
+    """The bending law for parameters ``q`` (module docstring), for a strip scaled by ``length_scale``; jit-able."""
+    s = length_scale
     if law_kind == "linear":
-        return LinearBending(jnp.exp(q[0]))
-    b_init, kappa0 = jnp.exp(q[0]), jnp.exp(q[1])
-    r = jax.nn.sigmoid(q[2])
-    return VoceBending(b_inf=r * b_init, m0=(1.0 - r) * b_init * kappa0, kappa0=kappa0)
+        return LinearBending(jnp.exp(q[0]) * s**3)
+    b_init, r, kappa0 = jnp.exp(q[0]), jnp.exp(q[1]), jnp.exp(q[2])
+    return VoceBending(b_inf=r * b_init * s**3, m0=(1.0 - r) * b_init * kappa0 * s**2, kappa0=kappa0 / s)
 
 
 def q_from_law(law, law_kind: str) -> np.ndarray:
-    """Inverse of :func:`law_from_q` (host)."""
+    """Inverse of :func:`law_from_q` at ``length_scale = 1`` (host)."""
     if law_kind == "linear":
         return np.array([math.log(float(law.b_init))])
     b_init = float(law.b_inf) + float(law.m0) / float(law.kappa0)
-    r = min(max(float(law.b_inf) / b_init, 1e-9), 1 - 1e-9)
-    return np.array([math.log(b_init), math.log(float(law.kappa0)), math.log(r / (1 - r))])
+    r = min(max(float(law.b_inf) / b_init, 1e-12), 1.0)
+    return np.array([math.log(b_init), math.log(r), math.log(float(law.kappa0))])
 
 
 def _physical(q, law_kind: str):

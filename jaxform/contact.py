@@ -49,7 +49,7 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from jaxform import tools, validate
+from jaxform import broadphase, tools, validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
@@ -235,15 +235,19 @@ def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
     return nearest_centroids(x[jnp.asarray(slave)], cen, k, chunk)
 
 
-def _ply_node(p, vp, tri_x, tri_v, gap0, area, params):
-    """One slave node against its K candidate triangles ((K, 3, 3) positions and velocities)."""
+def _ply_node(p, vp, tri_x, tri_v, side, gap0, area, params):
+    """One slave node against its K candidate triangles ((K, 3, 3) positions and velocities;
+    ``side`` (K,) +1, or -1 where the node faces the triangle's back)."""
     q, w = jax.vmap(closest_point_triangle, in_axes=(None, 0, 0, 0))(p, tri_x[:, 0], tri_x[:, 1], tri_x[:, 2])
     d2 = jnp.sum((p - q) ** 2, axis=-1)
     j = jnp.argmin(d2)
     a, b, c = tri_x[j]
-    n = safe_normalize(jnp.cross(b - a, c - a))
+    n = side[j] * safe_normalize(jnp.cross(b - a, c - a))
     d = p - q[j]
-    signed = jnp.where(jnp.dot(d, n) >= 0, 1.0, -1.0) * safe_norm(d)
+    dist = safe_norm(d)
+    # behind the triangle only within 60 degrees of -n: a node level with it (beside an edge)
+    # is not behind it whichever way rounding tips the plane test
+    signed = jnp.where(jnp.dot(d, n) < -0.5 * dist, -dist, dist)
     v_master = w[j] @ tri_v[j]
     force, pressure, g, e, pw = node_contact(signed, n, vp - v_master, gap0, area, params)
     return force, w[j], j, pressure, g, e, pw
@@ -253,18 +257,22 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
     """Node-to-surface contact between two plies of a stack, with friction.
 
     Each slave node (of the upper ply) is tested against its candidate triangles of the master
-    (lower) ply; the gap is the signed distance to the closest point, measured along the master
-    triangle's normal side (the side of ``(b - a) x (c - a)``: orient the master's faces towards
-    the slave ply), minus ``gap0`` (mid-surface to mid-surface distance of touching plies, ``(h_1
+    (lower) ply; the gap is the distance to the closest point, negative when the node lies behind
+    the master triangle (within 60 degrees of its back normal; the front is the side of ``(b - a)
+    x (c - a)``: orient the master's faces towards the slave ply), minus ``gap0`` (mid-surface to mid-surface distance of touching plies, ``(h_1
     + h_2) / 2``). The force on a slave node is applied, with the opposite sign, to the three
     nodes of the master triangle with the barycentric weights of the closest point, so momentum
     is conserved. A node beyond the master ply's edge sees a lateral distance, hence no contact.
+    Two-sided contact (self-contact, :mod:`jaxform.self_contact`): a candidate stored as ``~t``
+    (``-t - 1``) is triangle ``t`` seen from its back side (the side the node was on when the
+    table was built), so its normal is reversed.
 
     Args:
         x, v: (N, 3) all node positions (m) and velocities (m/s).
         slave: (N_s,) int slave node indices.
         triangles: (F, 3) int master triangles (:func:`quads_to_triangles` for quad meshes).
-        candidates: (N_s, K) int candidate triangles per slave (:func:`nearest_faces`).
+        candidates: (N_s, K) int candidate triangles per slave (:func:`jaxform.broadphase.candidates`;
+            ``~t`` for triangle ``t`` from its back side).
         gap0: () contact distance between mid-surfaces, m.
         area: () or (N_s,) tributary area of each slave node, m².
         params: :class:`ContactParams` (``friction`` 0.36 fabric–fabric).
@@ -278,9 +286,10 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
     cand = jnp.asarray(candidates)
     ns = slave.shape[0]
     area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (ns,))
-    tri_c = tri[cand]  # (N_s, K, 3) node indices
-    f, w, j, p, g, e, pw = jax.vmap(_ply_node, in_axes=(0, 0, 0, 0, None, 0, None))(
-        x[slave], v[slave], x[tri_c], v[tri_c], jnp.asarray(gap0, x.dtype), area, params
+    side = jnp.where(cand >= 0, 1.0, -1.0).astype(x.dtype)
+    tri_c = tri[jnp.where(cand >= 0, cand, ~cand)]  # (N_s, K, 3) node indices
+    f, w, j, p, g, e, pw = jax.vmap(_ply_node, in_axes=(0, 0, 0, 0, 0, None, 0, None))(
+        x[slave], v[slave], x[tri_c], v[tri_c], side, jnp.asarray(gap0, x.dtype), area, params
     )
     master_nodes = jnp.take_along_axis(tri_c, j[:, None, None], axis=1)[:, 0, :]  # (N_s, 3)
     force = jnp.zeros_like(x).at[slave].add(f)
@@ -440,12 +449,15 @@ class ToolLoad:
 class PlyLoad:
     """Ply–ply contact between two plies of a stack as an external load.
 
-    ``load_state`` is ``(candidates (N_s, K) int32, step () int32)``; the candidate table is rebuilt
-    with :func:`nearest_faces` every ``refresh_every`` calls (static), inside ``lax.cond``.
+    ``load_state`` is a :class:`jaxform.broadphase.SearchState` (its ``candidates`` first): the
+    ``k`` candidates per slave node come from the cell grid of :func:`jaxform.broadphase.candidates`
+    within ``gap0 + skin``, rebuilt inside ``lax.cond`` when a node has moved by half the skin
+    since the last refresh (or after ``refresh_every`` calls).
 
     Attributes:
         slave: (N_s,) int; triangles: (F, 3) int; gap0: () m; area: () or (N_s,) m²;
-        params: :class:`ContactParams`; k, refresh_every: static ints.
+        params: :class:`ContactParams`; skin: () m (default ``gap0``);
+        k, refresh_every, cap (triangles read per grid cell): static ints.
     """
 
     slave: Any
@@ -453,21 +465,30 @@ class PlyLoad:
     gap0: Any
     area: Any
     params: Any
+    skin: Any = None
     k: int = static_field(default=8)
-    refresh_every: int = static_field(default=50)
+    refresh_every: int = static_field(default=200)
+    cap: int = static_field(default=16)
+
+    def _skin(self):
+        return self.gap0 if self.skin is None else self.skin
+
+    def search(self, x):
+        """``(candidates (N_s, k) int32, overflow ())`` for positions ``x`` (N, 3)."""
+        ids, _, over = broadphase.candidates(x[self.slave], x[self.triangles], self.k, self.gap0 + self._skin(),
+                                             cap=self.cap)
+        return ids, over
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
-        return (nearest_faces(x, self.slave, self.triangles, self.k), jnp.asarray(0, jnp.int32))
+        return broadphase.initial_search_state(jnp.asarray(x), self.search)
 
     def force(self, x, v, t, load_state):
-        cand, n = load_state
-        cand = jax.lax.cond(n % self.refresh_every == 0,
-                            lambda: nearest_faces(x, self.slave, self.triangles, self.k), lambda: cand)
-        res = ply_contact(x, v, self.slave, self.triangles, cand, self.gap0, self.area, self.params)
+        st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
+        res = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, self.params)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
-                  "max_pressure": jnp.max(res.pressure)}
-        return res.force, (cand, n + 1), extras
+                  "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes, "search_overflow": st.overflow}
+        return res.force, st, extras
 
 
 __all__ = [

@@ -1,0 +1,172 @@
+"""Contact candidates of a moving surface by a cell grid of fixed capacity (issue 19).
+
+The narrow phase (:func:`jaxform.contact.ply_contact`) tests each node against ``K`` candidate
+triangles; this module finds them without looking at every triangle, with fixed shapes inside
+``jit`` (JAX MD's cell list, ``jax_md/partition.py``, with sorted keys instead of a dense grid so
+that a thin sheet in a large box costs nothing for its empty cells):
+
+1. bin the triangle centroids into cubic cells of side ``cell = reach + R`` (``R`` the largest
+   centroid-to-corner distance, ``reach`` the search distance): a triangle within ``reach`` of a
+   point has its centroid in the point's cell or one of the 26 around it;
+2. sort the cell keys (``(i << 20) | (j << 10) | k``, 1024 cells a side, indices clipped);
+3. per point, look up the 27 cells by binary search and read at most ``cap`` triangles from each
+   (fixed shape ``(27 cap,)``; a fuller cell is counted in ``overflow``, never silently enlarged);
+4. drop the pairs ``mask(point, triangle)`` refuses (a node's own neighbourhood in self-contact),
+   keep the ``K`` nearest centroids; a slot left empty gets the point's ``fallback`` triangle.
+
+Cost per refresh: a sort of the F keys and ``27 * cap`` distance tests per point, i.e. ``O(N +
+F log F)`` against ``O(N F)`` for :func:`jaxform.geometry.nearest_centroids`. The candidates stay
+valid while no point has moved by more than half the skin (``reach`` minus the contact distance)
+since the refresh (:func:`moved_beyond`, the Verlet-list criterion: it ties the refresh to the
+largest node speed).
+"""
+from __future__ import annotations
+
+from typing import Any, NamedTuple
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+__all__ = ["cell_size", "grid_keys", "neighbour_slots", "candidates", "moved_beyond", "SearchState", "initial_search_state",
+           "refreshed"]
+
+_BITS = 10
+_SIDE = 1 << _BITS  # cells per axis
+_OFFSETS = np.array([(i, j, k) for i in (-1, 0, 1) for j in (-1, 0, 1) for k in (-1, 0, 1)], np.int32)
+
+
+def cell_size(tri_x, reach):
+    """``reach + R`` (m): the cell side for triangles ``tri_x`` (F, 3, 3) m and search distance ``reach`` (m)."""
+    cen = jnp.mean(tri_x, axis=1)
+    r2 = jnp.max(jnp.sum((tri_x - cen[:, None, :]) ** 2, axis=-1))
+    return reach + jnp.sqrt(r2) * 1.0001 + 1e-12
+
+
+def _ijk(p, lo, cell):
+    return jnp.clip(jnp.floor((p - lo) / cell).astype(jnp.int32), 0, _SIDE - 1)
+
+
+def _key(ijk):
+    return (ijk[..., 0] << (2 * _BITS)) | (ijk[..., 1] << _BITS) | ijk[..., 2]
+
+
+def grid_keys(centroids, lo, cell):
+    """``(sorted_keys (F,), order (F,))``: cell keys of the centroids (F, 3) sorted, and the
+    triangle ids in that order."""
+    keys = _key(_ijk(centroids, lo, cell))
+    order = jnp.argsort(keys).astype(jnp.int32)
+    return keys[order], order
+
+
+def neighbour_slots(points, sorted_keys, order, lo, cell, cap: int):
+    """``(ids (B, 27 cap) int32, valid (B, 27 cap) bool, overflow (B,) int32)``: the triangles
+    binned in the 27 cells around each point (B, 3), at most ``cap`` per cell, and the number of
+    those cells holding more than ``cap``."""
+    ijk = _ijk(points, lo, cell)[:, None, :] + _OFFSETS[None]  # (B, 27, 3)
+    inside = jnp.all((ijk >= 0) & (ijk < _SIDE), axis=-1)
+    keys = jnp.where(inside, _key(ijk), -1)
+    start = jnp.searchsorted(sorted_keys, keys, side="left")
+    end = jnp.where(inside, jnp.searchsorted(sorted_keys, keys, side="right"), start)
+    slot = start[..., None] + jnp.arange(cap, dtype=start.dtype)  # (B, 27, cap)
+    valid = slot < end[..., None]
+    ids = order[jnp.clip(slot, 0, order.shape[0] - 1)]
+    b = points.shape[0]
+    return ids.reshape(b, -1), valid.reshape(b, -1), jnp.sum(end - start > cap, axis=1).astype(jnp.int32)
+
+
+def candidates(points, tri_x, k: int, reach, *, mask=None, fallback=None, cap: int = 16, chunk: int = 2048):
+    """The ``k`` triangles with the nearest centroids within reach of each point.
+
+    Args:
+        points: (N, 3) query points, m.
+        tri_x: (F, 3, 3) triangle corners, m.
+        k: candidates per point (static).
+        reach: () search distance, m (contact distance plus skin): every triangle with a point
+            closer than ``reach`` is among those looked at (while no cell overflows).
+        mask: optional ``mask(point_ids (B,), tri_ids (B, M)) -> (B, M) bool``, the pairs allowed.
+        fallback: optional (N,) int triangle of each point for the empty slots (default 0); it
+            must be a pair ``mask`` allows, and is then beyond ``reach`` whenever a slot is empty.
+        cap: triangles read per cell (static); chunk: points per block (static).
+
+    Returns:
+        ``(ids (N, k) int32, found (N, k) bool, overflow () int32)``: nearest first; empty slots
+        hold the point's best candidate, or its ``fallback`` when it has none; ``overflow`` counts
+        (point, cell) lookups that met a cell with more than ``cap`` triangles.
+    """
+    points = jnp.asarray(points)
+    tri_x = jnp.asarray(tri_x)
+    n = points.shape[0]
+    cen = jnp.mean(tri_x, axis=1)
+    cell = cell_size(tri_x, reach)
+    lo = jnp.minimum(jnp.min(cen, axis=0), jnp.min(points, axis=0)) - cell
+    sorted_keys, order = grid_keys(cen, lo, cell)
+    fb = jnp.zeros((n,), jnp.int32) if fallback is None else jnp.asarray(fallback, jnp.int32)
+    chunk = int(max(1, min(chunk, n)))
+    pad = (-n) % chunk
+    pid = jnp.concatenate([jnp.arange(n, dtype=jnp.int32), jnp.zeros((pad,), jnp.int32)]).reshape(-1, chunk)
+    k_eff = int(min(k, 27 * cap))
+
+    def block(ids_p):
+        p = points[ids_p]
+        ids, valid, over = neighbour_slots(p, sorted_keys, order, lo, cell, cap)
+        if mask is not None:
+            valid = valid & mask(ids_p, ids)
+        d2 = jnp.sum((p[:, None, :] - cen[ids]) ** 2, axis=-1)
+        d2 = jnp.where(valid, d2, jnp.inf)
+        neg, j = jax.lax.top_k(-d2, k_eff)
+        best = jnp.take_along_axis(ids, j, axis=1)
+        found = jnp.isfinite(neg)
+        first = jnp.where(found[:, :1], best[:, :1], fb[ids_p][:, None])
+        return jnp.where(found, best, first), found, over
+
+    ids, found, over = jax.lax.map(block, pid)
+    ids, found = ids.reshape(-1, k_eff)[:n], found.reshape(-1, k_eff)[:n]
+    if k_eff < k:  # more slots than the cells can fill: repeat the first
+        ids = jnp.concatenate([ids, jnp.broadcast_to(ids[:, :1], (n, k - k_eff))], axis=1)
+        found = jnp.concatenate([found, jnp.zeros((n, k - k_eff), bool)], axis=1)
+    return ids.astype(jnp.int32), found, jnp.sum(over.reshape(-1)[:n])
+
+
+def moved_beyond(x, x_ref, distance):
+    """() bool: some point of ``x`` (N, 3) is farther than ``distance`` (m) from ``x_ref`` (N, 3)."""
+    d2 = jnp.sum((x - x_ref) ** 2, axis=-1)
+    return jnp.max(d2) > distance * distance
+
+
+class SearchState(NamedTuple):
+    """State of a contact load's candidate table (a load state: fixed shapes).
+
+    Attributes:
+        candidates: (N_s, K) int32 triangle ids (``~id`` where the node was on the back side).
+        step: () int32 calls so far; x_ref: (N, 3) positions at the last refresh, m;
+        last: () int32 call of the last refresh; refreshes: () int32 refreshes so far;
+        overflow: () int32 overflowing cell lookups at the last refresh (0 when complete).
+    """
+
+    candidates: Any
+    step: Any
+    x_ref: Any
+    last: Any
+    refreshes: Any
+    overflow: Any
+
+
+def initial_search_state(x, search) -> SearchState:
+    """The :class:`SearchState` for positions ``x`` (N, 3); ``search(x) -> (candidates, overflow)``."""
+    cand, over = search(x)
+    z = jnp.asarray(0, jnp.int32)
+    return SearchState(cand, z, x, z, z + 1, jnp.asarray(over, jnp.int32))
+
+
+def refreshed(state: SearchState, x, search, half_skin, every: int) -> SearchState:
+    """``state`` advanced by one call: the table rebuilt (``lax.cond``) when some node moved more
+    than ``half_skin`` (m) since the last refresh, or ``every`` calls have passed."""
+    due = moved_beyond(x, state.x_ref, half_skin) | (state.step - state.last >= every)
+
+    def fresh():
+        cand, over = search(x)
+        return SearchState(cand, state.step, x, state.step, state.refreshes + 1, jnp.asarray(over, jnp.int32))
+
+    new = jax.lax.cond(due, fresh, lambda: state)
+    return new._replace(step=state.step + 1)

@@ -22,11 +22,11 @@ def test_build_wires_case_b():
     model, state, info = forming.build(case)
     h = case.ply_thickness
     n = len(info.x0)
-    assert len(model.loads) == 4 and info.n_ply_loads == 1
+    assert len(model.loads) == 5 and info.n_ply_loads == 1  # the tools, the stack, the self-contact
     # ply 1 on top at 1.5 h, ply 2 at h/2 on the die
     np.testing.assert_allclose(info.x0[info.ply_id == 1, 2], 1.5 * h)
     np.testing.assert_allclose(info.x0[info.ply_id == 2, 2], 0.5 * h)
-    punch, die, holder, ply = model.loads
+    punch, die, holder, ply, _ = model.loads
     np.testing.assert_array_equal(np.asarray(punch.active), (info.ply_id == 1).astype(float))
     np.testing.assert_array_equal(np.asarray(die.active), (info.ply_id == 2).astype(float))
     assert holder.force_controlled and float(holder.clamp_force) == 1000.0

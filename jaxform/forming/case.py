@@ -22,7 +22,7 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
     [holder]   mode = "gap" | "force"; gap_mm (gap mode); force_N, mass_kg (force mode)
     [process]  stroke_mm, speed_mm_per_s (simulated punch speed), ramp_fraction, frames
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety, slip_velocity_fraction,
-               damping_ratio
+               damping_ratio, optional self_contact (default true: folds lie on themselves)
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling (>= 1,
                default 1 = off: inertia added to fibre stretching only, the membrane limit of
                the step grows by that factor; see jaxform.fibre_mass)
@@ -104,12 +104,14 @@ class ProcessSpec:
 class ContactSpec:
     """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.contact.contact_params`), its
     stability ``safety``, friction regularisation speed as a fraction of the punch speed, normal
-    damping ratio."""
+    damping ratio; ``self_contact``: every ply with itself and the plies not next to it
+    (:mod:`jaxform.self_contact`, on by default)."""
 
     penalty_stiffness: float | None
     safety: float
     slip_velocity_fraction: float
     damping_ratio: float
+    self_contact: bool = True
 
 
 @dataclasses.dataclass(frozen=True)
@@ -174,7 +176,8 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     "process": {"stroke_mm": ("float", True), "speed_mm_per_s": ("float", True),
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("float", True),
-                "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True)},
+                "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
+                "self_contact": ("bool", False)},
     "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("float", False)},
 }
 _VOCE_KEYS = ("b_inf_Nm", "m0_N", "kappa0_per_m")
@@ -188,6 +191,10 @@ def _typed(key: str, kind: str, value: Any):
     if kind == "str":
         if not isinstance(value, str):
             raise _err(key, value, "must be a string")
+        return value
+    if kind == "bool":
+        if not isinstance(value, bool):
+            raise _err(key, value, "must be true or false")
         return value
     if kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
@@ -348,7 +355,8 @@ def _build(d) -> Case:
                    "turns sticky)" + (f"; with contact.safety = {c['safety']:g} the explicit step is stable only up "
                                       f"to {zeta_stable:.3g}" if zeta_stable < 1.0 else ""))
     contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=c["safety"],
-                               slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"])
+                               slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"],
+                               self_contact=c.get("self_contact", True))
 
     n = d["numerics"]
     if n["dtype"] not in ("float32", "float64"):
@@ -479,7 +487,7 @@ def to_dict(case: Case) -> dict:
                     "frames": p.frames},
         "contact": {"penalty_stiffness_Pa_per_m": "auto" if c.penalty_stiffness is None else c.penalty_stiffness,
                     "safety": c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
-                    "damping_ratio": c.damping_ratio},
+                    "damping_ratio": c.damping_ratio, "self_contact": c.self_contact},
         "numerics": numerics,
     }
 

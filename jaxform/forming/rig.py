@@ -6,7 +6,9 @@ force-controlled in Case B), the punch apex on the stack moving down by the stro
 
 Loads, in ``model.loads`` order: punch, die, holder (:class:`jaxform.contact.ToolLoad`), then one
 :class:`jaxform.contact.PlyLoad` per neighbouring ply pair (the upper ply's nodes against the lower
-ply's upward-facing triangles, gap ``h``, fabric–fabric friction). Ply 1 touches punch and holder,
+ply's upward-facing triangles, gap ``h``, fabric–fabric friction), then, with
+``contact.self_contact`` (default), one :class:`jaxform.self_contact.SelfContactLoad`: every ply
+with itself and with the plies not next to it, two-sided, gap ``h``. Ply 1 touches punch and holder,
 ply n the die, middle plies only their neighbours. Every tool contact acts at the ply's face
 (offset ``h / 2``) with each node's tributary area.
 
@@ -36,6 +38,7 @@ import numpy as np
 from jaxform import contact, integrate, units
 from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
 from jaxform.mesh import Mesh
+from jaxform.self_contact import self_contact_load
 from jaxform.shell import Shell, stable_time_step
 
 PUNCH, DIE, HOLDER = 0, 1, 2
@@ -283,6 +286,8 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype):
                   damping_ratio=c.damping_ratio, safety=c.safety, interfaces=n_if)
     params_tool = contact.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
     params_ply = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
+    common["interfaces"] = n_if + 1  # a folded node: tools or plies, and a layer of itself
+    params_self = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
 
     area = np.asarray(mesh.node_area, np.float64)
     ply_id = _ply_ids(mesh)
@@ -310,8 +315,20 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype):
         (a, b), (t0, t1) = mesh.ply_nodes[i], mesh.ply_tris[i + 1]
         loads.append(contact.PlyLoad(slave=jnp.asarray(np.arange(a, b), jnp.int32),
                                      triangles=jnp.asarray(tris[t0:t1], jnp.int32), gap0=as_arr(h),
-                                     area=as_arr(area[a:b]), params=params_ply))
+                                     area=as_arr(area[a:b]), params=params_ply, skin=as_arr(_skin(case))))
+    if c.self_contact:
+        n = case.n_plies
+        pair_ok = np.abs(np.arange(n + 1)[:, None] - np.arange(n + 1)[None, :]) != 1  # neighbours: PlyLoad
+        loads.append(self_contact_load(mesh.nodes, tris, area, ply_id, h, params_self, pair_ok=pair_ok,
+                                       skin=_skin(case), dtype=jdtype))
     return tuple(loads), holder_state
+
+
+def _skin(case: Case) -> float:
+    """Search margin of the fabric contacts beyond the contact distance, m: the larger of the ply
+    thickness and a quarter element. Candidates are rebuilt when a node has moved by half of it,
+    so the refresh follows the largest node speed (:func:`jaxform.broadphase.refreshed`)."""
+    return max(float(case.ply_thickness), 0.25 * float(case.element_size))
 
 
 def _ply_ids(mesh: Mesh) -> np.ndarray:

@@ -1,0 +1,146 @@
+"""Self-contact and the cell-grid contact search (issue 19): the grid finds the triangle brute
+force finds; a fold lying on itself closer than h is pushed apart, two-sided, momentum-free;
+ordinary bending and a flat sheet are not contact; the rig wires it by default."""
+import numpy as np
+import jax
+import jax.numpy as jnp
+import pytest
+
+from jaxform import broadphase, cases, contact, forming
+from jaxform.geometry import point_triangle_sqdist
+from jaxform.metrics.intersections import triangulate
+from jaxform.self_contact import SelfContactLoad, self_contact_load
+from test_intersections import folded_strip
+
+H = 4e-4
+
+
+def _wavy_ply(n, size, z0, amp, phase):
+    s = np.linspace(0.0, size, n)
+    X, Y = np.meshgrid(s, s, indexing="ij")
+    Z = z0 + amp * np.sin(2 * np.pi * X / size + phase) * np.cos(2 * np.pi * Y / size)
+    idx = np.arange(n * n).reshape(n, n)
+    q = np.column_stack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()])
+    return np.column_stack([X.ravel(), Y.ravel(), Z.ravel()]), triangulate(q)[0]
+
+
+def test_grid_search_finds_the_brute_force_nearest_triangle():
+    lower, tri = _wavy_ply(17, 0.03, 0.0, 1.5e-3, 0.0)
+    upper, _ = _wavy_ply(13, 0.028, H, 1.5e-3, 0.3)
+    upper[:, :2] += 0.001
+    x = jnp.asarray(np.vstack([lower, upper]))
+    slave = np.arange(len(lower), len(lower) + len(upper))
+    load = contact.PlyLoad(slave=slave, triangles=jnp.asarray(tri, jnp.int32), gap0=H, area=1e-6,
+                           params=contact.ContactParams(stiffness=1e10, friction=0.36), skin=2 * H)
+    cand, over = jax.jit(load.search)(x)
+    assert int(over) == 0
+    p = np.asarray(x)[slave]
+    t = np.asarray(x)[tri]
+    d2_all = np.asarray(point_triangle_sqdist(p[:, None], t[None, :, 0], t[None, :, 1], t[None, :, 2]))
+    brute = d2_all.argmin(axis=1)
+    cand = np.asarray(cand)
+    d2_cand = np.take_along_axis(d2_all, cand, axis=1)
+    reach = 3 * H  # gap0 + skin: every triangle within it is looked at
+    near = d2_all.min(axis=1) < reach**2
+    assert near.sum() > 0.5 * len(slave)
+    # the same closest distance (ties between the two halves of a quad pick either half)
+    np.testing.assert_allclose(d2_cand.min(axis=1)[near], d2_all.min(axis=1)[near], rtol=1e-5)
+    # the O(N F) search it replaces agrees
+    old = np.asarray(contact.nearest_faces(x, slave, tri, 8))
+    np.testing.assert_allclose(np.take_along_axis(d2_all, old, 1).min(1)[near], d2_all.min(axis=1)[near], rtol=1e-5)
+
+
+def test_grid_reports_overflowing_cells():
+    pts = jnp.zeros((1, 3))
+    tri_x = jnp.asarray(np.random.default_rng(1).normal(0, 1e-4, (50, 3, 3)))
+    ids, found, over = broadphase.candidates(pts, tri_x, 8, 1e-3, cap=4)
+    assert int(over) == 1 and int(found.sum()) == 4  # one cell, read up to its capacity, and said so
+
+
+def _fold(gap, ns=41, ny=7):
+    """A strip folded over itself (layers ``gap`` apart) and its flat reference."""
+    nodes, t, layer = folded_strip(gap, length=0.02, width=0.006, ns=ns, ny=ny, quads=False)
+    seg = np.linalg.norm(np.diff(nodes[::ny][:, [0, 2]], axis=0), axis=1)
+    s = np.concatenate([[0.0], np.cumsum(seg)])
+    x0 = np.column_stack([np.repeat(s, ny), nodes[:, 1], np.zeros(len(nodes))])
+    return nodes, x0, t
+
+
+def _load(x0, t, **kw):
+    params = contact.ContactParams(stiffness=1e10, friction=0.36)
+    return self_contact_load(x0, t, np.full(len(x0), 1e-6), np.zeros(len(x0), int), H, params, **kw)
+
+
+def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
+    nodes, x0, t = _fold(0.9 * H)
+    load = _load(x0, t)
+    assert isinstance(load, SelfContactLoad)
+    x = jnp.asarray(nodes, jnp.float32)
+    st = load.initial_state(x)
+    assert np.any(np.asarray(st.candidates) < 0)  # some nodes see triangles from their back
+    v = np.zeros_like(nodes)
+    v[nodes[:, 2] > 0.5 * H, 1] = 0.01  # upper layer sliding across
+    f, st2, ex = jax.jit(load.force)(x, jnp.asarray(v, jnp.float32), 0.0, st)
+    f = np.asarray(f)
+    upper, lower = nodes[:, 2] > 0.5 * H, (nodes[:, 2] < 0.5 * H) & (nodes[:, 0] < 0.019)
+    flat_part = (nodes[:, 0] > 0.001) & (nodes[:, 0] < 0.017)
+    assert np.all(f[upper & flat_part, 2] > 0) and np.all(f[lower & flat_part, 2] < 0)  # apart
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-4 * np.abs(f).max())  # float32 sums
+    # both passes (each with half the area) add up to one contact: k * (0.1 h) * A on a node
+    np.testing.assert_allclose(np.median(f[upper & flat_part, 2]), 1e10 * 0.1 * H * 1e-6, rtol=1e-3)
+    assert np.all(f[upper & flat_part, 1] < 0)  # friction against the slip
+    assert int(st2.step) == 1 and int(ex["search_overflow"]) == 0
+    # layers h apart (and more): no force; gradient of the penalty energy finite
+    nodes2, x02, t2 = _fold(1.1 * H)
+    load2 = _load(x02, t2)
+    x2 = jnp.asarray(nodes2, jnp.float32)
+    f2, _, _ = load2.force(x2, jnp.zeros_like(x2), 0.0, load2.initial_state(x2))
+    assert float(jnp.abs(f2).max()) == 0.0
+    cand = st.candidates
+    g = jax.grad(lambda xx: contact.ply_contact(xx, jnp.zeros_like(xx), load.slave, load.triangles, cand, load.gap0,
+                                                load.area, load.params).energy)(x)
+    assert np.all(np.isfinite(np.asarray(g))) and float(jnp.abs(g).max()) > 0
+
+
+def test_bending_and_a_flat_sheet_are_not_contact():
+    # a sheet rolled to a cylinder of radius 2 h, one element = 0.5 h: its neighbourhood is excluded
+    n_s, ny = 40, 5
+    s = np.linspace(0.0, 0.9 * 2 * np.pi * 2 * H, n_s)
+    y = np.linspace(0.0, 0.002, ny)
+    S, Y = np.meshgrid(s, y, indexing="ij")
+    R = 2 * H
+    nodes = np.column_stack([R * np.sin(S.ravel() / R), Y.ravel(), R - R * np.cos(S.ravel() / R)])
+    x0 = np.column_stack([S.ravel(), Y.ravel(), np.zeros(S.size)])
+    idx = np.arange(n_s * ny).reshape(n_s, ny)
+    q = np.column_stack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(), idx[:-1, 1:].ravel()])
+    t, _ = triangulate(q)
+    for x, ref in ((nodes, x0), (x0, x0)):
+        load = _load(ref, t)
+        xj = jnp.asarray(x, jnp.float32)
+        f, _, ex = load.force(xj, jnp.zeros_like(xj), 0.0, load.initial_state(xj))
+        assert float(jnp.abs(f).max()) == 0.0 and float(ex["min_gap"]) > 0
+
+
+def _rig_loads(name, *keys):
+    """The contact loads the rig builds for a coarse preset (no compilation)."""
+    from jaxform.forming import rig
+
+    case = cases.apply_overrides(cases.with_element_size(cases.load(name), 25e-3), list(keys))
+    mesh = rig.build_mesh(case)
+    return case, mesh, rig._loads(case, mesh, rig.ply_fabrics(case), 1e-6, jnp.float32)[0]
+
+
+def test_rig_wires_self_contact_by_default():
+    case, mesh, loads = _rig_loads("case-a-ncf-nlbm")
+    assert len(loads) == 4 and isinstance(loads[3], SelfContactLoad)
+    sc = loads[3]
+    h = case.ply_thickness
+    assert float(sc.gap0) == pytest.approx(h) and float(sc.params.friction) == pytest.approx(0.36)
+    np.testing.assert_allclose(np.asarray(sc.area).sum(), 0.5 * case.blank_size**2, rtol=1e-5)
+    x = jnp.asarray(mesh.nodes, jnp.float32)
+    f = jax.jit(lambda y: sc.force(y, jnp.zeros_like(y), 0.0, sc.initial_state(y))[0])(x)
+    assert float(jnp.abs(f).max()) == 0.0  # the flat blank does not touch itself
+    assert len(_rig_loads("case-a-ncf-nlbm", "contact.self_contact=false")[2]) == 3
+    # a stack: neighbouring plies are the PlyLoad's, each ply with itself the self-contact's
+    ok = np.asarray(_rig_loads("case-b-woven-nlbm")[2][4].pair_ok)
+    assert ok[1, 1] and ok[2, 2] and not ok[1, 2] and not ok[2, 1]

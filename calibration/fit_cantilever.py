@@ -28,7 +28,8 @@ what :func:`jaxform.io.calibration_files.read_profile_csv` refuses. A fit that i
 (the optimiser did not converge, the fitted strip is not an equilibrium, or its rmse is over twice
 the noise read off the profile: no Voce law reproduces it) writes params.json with ``converged:
 false`` and the ``reason``, says why on stderr (and in the plot's title) and exits 1;
-Ctrl-C stops with a message, no params.json, exit 130.
+Ctrl-C stops with a message, no params.json, exit 130. The areal mass only scales the law (a strip's shape depends on
+M / w): a wrong --areal-mass-gsm gives a law wrong by the same factor and passes every check.
 """
 from __future__ import annotations
 

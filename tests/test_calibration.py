@@ -183,6 +183,16 @@ def test_fit_cantilever_command(tmp_path, capsys):
     assert rc == 2 and "negative downwards" in err
 
 
+def test_areal_mass_only_scales_the_law():
+    """The hanging strip's shape depends on M(kappa) / w only: a profile fitted with twice the areal
+    mass gives twice the law and the same residual. A wrong areal mass is therefore invisible in
+    profiles (every check of issue 18 passes); it has to be right at the input."""
+    prof = _profile(0.09, seed=1)
+    a, b = (C.fit_cantilever([prof], areal_mass=m, simulate=SMALL, compute_b41_5=False) for m in (MASS, 2 * MASS))
+    assert b.b_init == pytest.approx(2 * a.b_init, rel=1e-3) and b.m0 == pytest.approx(2 * a.m0, rel=1e-2)
+    assert b.rmse == pytest.approx(a.rmse, rel=1e-3) and a.trustworthy and b.trustworthy
+
+
 # ----- noise, and the Fisher uncertainty against repeated fits -----------------------------------
 
 

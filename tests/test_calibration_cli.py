@@ -139,6 +139,22 @@ def test_fit_cantilever_profile_no_voce_law_produces_exits_1(tmp_path, capsys, m
     assert titles and "NOT TRUSTWORTHY" in titles[0] and (tmp_path / "fit.png").exists()
 
 
+def test_fit_cantilever_wrong_overhang_exits_1(tmp_path, capsys):
+    """A 90 mm strip's profile given as 130 mm: no law hangs a 130 mm strip through those points
+    (exit 1, the reason). A wrong areal mass cannot be caught this way: see
+    test_calibration.test_areal_mass_only_scales_the_law."""
+    from jaxform.materials import VoceBending
+
+    out = simulate_small(VoceBending(b_inf=3e-5, m0=5e-3, kappa0=25.0), overhang=0.09, areal_mass=0.21)
+    xq = np.linspace(0.02, 0.995, 40) * float(out.x[-1])
+    zq = np.asarray(interp_profile(jnp.asarray(xq), out.x, out.z)) + np.random.default_rng(0).normal(0, 5e-5, xq.size)
+    p = _write(tmp_path / "p.csv", 1e3 * xq, 1e3 * zq)
+    res = tmp_path / "params.json"
+    rc, stdout, err = _cli(_args(p, res, overhang="130"), capsys)
+    assert rc == 1 and "no law of this kind reproduces the profile (check the overhang" in err, (stdout, err)
+    assert json.loads(res.read_text())["converged"] is False
+
+
 def test_fit_cantilever_that_cannot_start_writes_nothing(tmp_path, capsys):
     x, z = _profile_rows()
     p = _write(tmp_path / "p.csv", x, z)

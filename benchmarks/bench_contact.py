@@ -1,0 +1,93 @@
+"""Fabric contact benchmark (issue 19, done-when item 4): the search and the self-contact's share.
+
+``run(quick)`` returns named figures:
+
+* ``search_case_b_<S>mm``: the stack-contact candidate search of Case B alone (ply 1's nodes
+  against ply 2's triangles, flat blank): the old ``O(N_s F)`` :func:`jaxform.contact.nearest_faces`
+  and the cell grid of :func:`jaxform.broadphase.candidates` (``PlyLoad.search``), seconds per
+  call after compilation; at 1 mm (2 x 63k nodes, 125k triangles) the old search is timed on
+  ``old_sample`` slave nodes and scaled by ``N_s / old_sample`` (its cost is exactly linear in the
+  slave count), the new on all of them.
+* ``share_<preset>_<S>mm``: ms per step of the full forming step with and without self-contact
+  (``run_steps``, best of 3), the self-contact load alone (narrow phase, no refresh), one refresh
+  of its candidate table, and the share of the step it takes.
+
+Timings depend on the machine's load: say so when quoting them.
+"""
+from __future__ import annotations
+
+import time
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+
+def _best(f, *a, repeat=3):
+    jax.block_until_ready(f(*a))
+    t = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        jax.block_until_ready(f(*a))
+        t.append(time.perf_counter() - t0)
+    return min(t)
+
+
+def search_cost(size_mm: float, old_sample: int | None = 4096) -> dict:
+    from jaxform import cases, contact
+    from jaxform.forming import rig
+
+    case = cases.with_element_size(cases.load("case-b-woven-nlbm"), size_mm * 1e-3)
+    mesh = rig.build_mesh(case)
+    x = jnp.asarray(mesh.nodes, jnp.float32)
+    (a, b), (t0, t1) = mesh.ply_nodes[0], mesh.ply_tris[1]
+    slave = jnp.arange(a, b, dtype=jnp.int32)
+    tris = jnp.asarray(np.asarray(mesh.tris)[t0:t1], jnp.int32)
+    h = float(case.ply_thickness)
+    load = contact.PlyLoad(slave=slave, triangles=tris, gap0=h, area=1.0,
+                           params=contact.ContactParams(stiffness=1e10), skin=max(h, 0.25 * size_mm * 1e-3))
+    new = _best(jax.jit(load.search), x)
+    n_old = len(slave) if old_sample is None else min(old_sample, len(slave))
+    old_fn = jax.jit(lambda y: contact.nearest_faces(y, slave[:n_old], tris, 8))
+    old = _best(old_fn, x, repeat=1) * len(slave) / n_old
+    return {"slave_nodes": int(len(slave)), "triangles": int(len(tris)), "old_s": old, "old_timed_on": int(n_old),
+            "new_s": new, "speedup": old / new}
+
+
+def contact_share(name: str, size_mm: float, n: int = 50) -> dict:
+    from jaxform import cases, forming
+
+    c = cases.with_element_size(cases.load(name), size_mm * 1e-3)
+    out = {}
+    for label, keys in (("on", []), ("off", ["contact.self_contact=false"])):
+        model, state, info = forming.build(cases.apply_overrides(c, keys))
+        f = jax.jit(lambda m, s: forming.run_steps(m, s, s.energies, s.x, n=n).x)
+        out[f"step_{label}_ms"] = 1e3 * _best(f, model, state) / n
+        if label == "on":
+            sc, ls = model.loads[-1], state.loads[-1]
+
+            def narrow(m, s, ld=sc, st=ls):
+                def one(xv, _):
+                    x, v = xv
+                    fo = ld.force(x, v, s.t, st)[0]
+                    return (x + 1e-15 * fo, v), None
+                return jax.lax.scan(one, (s.x, s.v), None, length=n)[0][0]
+
+            out["self_contact_ms"] = 1e3 * _best(jax.jit(narrow), model, state) / n
+            out["refresh_ms"] = 1e3 * _best(jax.jit(lambda y, ld=sc: ld.search(y)[0]), state.x)
+            out["nodes"] = int(len(info.x0))
+    out["share_of_step"] = (out["step_on_ms"] - out["step_off_ms"]) / out["step_on_ms"]
+    out["narrow_share_of_step"] = out["self_contact_ms"] / out["step_on_ms"]
+    return out
+
+
+def run(quick: bool = False) -> dict:
+    figures = {}
+    if quick:
+        figures["search_case_b_8mm"] = search_cost(8.0, old_sample=None)
+        figures["share_case-a-ncf-nlbm_8mm"] = contact_share("case-a-ncf-nlbm", 8.0, n=20)
+        return figures
+    figures["search_case_b_1mm"] = search_cost(1.0)
+    for size in (4.0, 2.0):
+        figures[f"share_case-a-ncf-nlbm_{size:g}mm"] = contact_share("case-a-ncf-nlbm", size)
+    return figures

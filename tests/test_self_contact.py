@@ -76,7 +76,6 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert isinstance(load, SelfContactLoad)
     x = jnp.asarray(nodes, jnp.float32)
     st = load.initial_state(x)
-    assert np.any(np.asarray(st.candidates) < 0)  # some nodes see triangles from their back
     v = np.zeros_like(nodes)
     v[nodes[:, 2] > 0.5 * H, 1] = 0.01  # upper layer sliding across
     f, st2, ex = jax.jit(load.force)(x, jnp.asarray(v, jnp.float32), 0.0, st)
@@ -89,6 +88,12 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     np.testing.assert_allclose(np.median(f[upper & flat_part, 2]), 1e10 * 0.1 * H * 1e-6, rtol=1e-3)
     assert np.all(f[upper & flat_part, 1] < 0)  # friction against the slip
     assert int(st2.step) == 1 and int(ex["search_overflow"]) == 0
+    # two-sided: every triangle turned over, the layers are seen from their backs, same forces
+    load_r = _load(x0, t[:, ::-1].copy())
+    st_r = load_r.initial_state(x)
+    assert np.all(np.asarray(st_r.candidates)[upper & flat_part, 0] < 0)  # the nearest: the other layer
+    f_r = np.asarray(jax.jit(load_r.force)(x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
+    np.testing.assert_allclose(f_r, f, atol=1e-5 * np.abs(f).max())
     # layers h apart (and more): no force; gradient of the penalty energy finite
     nodes2, x02, t2 = _fold(1.1 * H)
     load2 = _load(x02, t2)

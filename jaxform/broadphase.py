@@ -75,7 +75,8 @@ def neighbour_slots(points, sorted_keys, order, lo, cell, cap: int):
     return ids.reshape(b, -1), valid.reshape(b, -1), jnp.sum(end - start > cap, axis=1).astype(jnp.int32)
 
 
-def candidates(points, tri_x, k: int, reach, *, mask=None, fallback=None, cap: int = 16, chunk: int = 2048):
+def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback=None, cap: int = 16,
+               chunk: int = 2048):
     """The ``k`` triangles with the nearest centroids within reach of each point.
 
     Args:
@@ -85,6 +86,8 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, fallback=None, cap: i
         reach: () search distance, m (contact distance plus skin): every triangle with a point
             closer than ``reach`` is among those looked at (while no cell overflows).
         mask: optional ``mask(point_ids (B,), tri_ids (B, M)) -> (B, M) bool``, the pairs allowed.
+        refine: optional costlier test of the same form, applied only to the ``2 k`` nearest pairs
+            ``mask`` allows (a short list), before the ``k`` nearest are kept.
         fallback: optional (N,) int triangle of each point for the empty slots (default 0); it
             must be a pair ``mask`` allows, and is then beyond ``reach`` whenever a slot is empty.
         cap: triangles read per cell (static); chunk: points per block (static).
@@ -114,6 +117,10 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, fallback=None, cap: i
             valid = valid & mask(ids_p, ids)
         d2 = jnp.sum((p[:, None, :] - cen[ids]) ** 2, axis=-1)
         d2 = jnp.where(valid, d2, jnp.inf)
+        if refine is not None:
+            neg, j = jax.lax.top_k(-d2, min(2 * k_eff, d2.shape[1]))
+            ids = jnp.take_along_axis(ids, j, axis=1)
+            d2 = jnp.where(refine(ids_p, ids), -neg, jnp.inf)
         neg, j = jax.lax.top_k(-d2, k_eff)
         best = jnp.take_along_axis(ids, j, axis=1)
         found = jnp.isfinite(neg)

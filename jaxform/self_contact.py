@@ -49,7 +49,8 @@ class SelfContactLoad:
             distance h, m; area: (N,) half the tributary area, m²; params: ContactParams.
         group: (N,) int32 ply of each node; tri_group: (F,) int32 ply of each triangle.
         pair_ok: (G, G) bool: plies whose nodes and triangles may touch here.
-        x0: (N, 3) reference positions, m; exclusion: () own-neighbourhood distance, m.
+        x0: (N, 3) reference positions, m; c0: (F, 3) reference centroids, m;
+        exclusion: () own-neighbourhood distance, m.
         fallback: (N,) int32 a triangle each node may touch, far away in the reference.
         skin: () m; k, refresh_every, cap: static ints.
     """
@@ -63,12 +64,20 @@ class SelfContactLoad:
     tri_group: Any
     pair_ok: Any
     x0: Any
+    c0: Any
     exclusion: Any
     fallback: Any
     skin: Any
     k: int = static_field(default=8)
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=32)
+
+    def plausible(self, nodes, tris):
+        """(B, M) bool, cheap: the plies may touch and the reference centroid is not closer than
+        ``exclusion`` (the closest point is no farther than the centroid)."""
+        g, tg = self.group[nodes][:, None], self.tri_group[tris]
+        d2 = jnp.sum((self.x0[nodes][:, None, :] - self.c0[tris]) ** 2, axis=-1)
+        return self.pair_ok[g, tg] & ~((g == tg) & (d2 < self.exclusion**2))
 
     def allowed(self, nodes, tris):
         """(B, M) bool: node ``nodes`` (B,) may touch triangle ``tris`` (B, M)."""
@@ -81,8 +90,8 @@ class SelfContactLoad:
     def search(self, x):
         """``(candidates (N, k) int32 with sides, overflow ())`` for positions ``x`` (N, 3)."""
         tri_x = x[self.triangles]
-        ids, _, over = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.allowed,
-                                             fallback=self.fallback, cap=self.cap)
+        ids, _, over = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
+                                             refine=self.allowed, fallback=self.fallback, cap=self.cap)
         t = tri_x[ids]  # (N, k, 3, 3)
         q, _ = closest_point_triangle(x[:, None, :], t[..., 0, :], t[..., 1, :], t[..., 2, :])
         nrm = jnp.cross(t[..., 1, :] - t[..., 0, :], t[..., 2, :] - t[..., 0, :])
@@ -140,6 +149,6 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
     return SelfContactLoad(
         slave=jnp.arange(len(x0), dtype=jnp.int32), triangles=jnp.asarray(tris, jnp.int32), gap0=as_f(h),
         area=as_f(0.5 * np.asarray(node_area, np.float64)), params=params, group=jnp.asarray(group, jnp.int32),
-        tri_group=jnp.asarray(tg, jnp.int32), pair_ok=jnp.asarray(ok), x0=as_f(x0),
+        tri_group=jnp.asarray(tg, jnp.int32), pair_ok=jnp.asarray(ok), x0=as_f(x0), c0=as_f(c0),
         exclusion=as_f(2.0 * h if exclusion is None else exclusion), fallback=jnp.asarray(fallback, jnp.int32),
         skin=as_f(h if skin is None else skin), k=k, refresh_every=refresh_every, cap=cap)

@@ -428,13 +428,20 @@ def fit_cantilever(
         explored.append((coarse.cost(q), q))
     explored.sort(key=lambda t: t[0])
     best = None
-    for _, q in explored[: max(1, n_polish)]:
+    tried = 0
+    for _, q in explored + [(c, cands[i]) for c, i in scored]:  # explored first; raw starts if none solves
+        if tried >= max(1, n_polish) or not np.isfinite(full.cost(inside(q))):
+            continue  # the full model may not reach equilibrium where the exploration model did
+        tried += 1
         opt = run(full, inside(q), max_iter, "polish")
         cost = full.cost(opt.x)
         if best is None or cost < best[0]:
             best = (cost, opt)
         if math.sqrt(cost / n_data) * _RES_SCALE <= rmse_limit * sigma:
             break
+    if best is None:
+        raise RuntimeError("fit_cantilever: the full simulation failed (non-finite or not converged) at every "
+                           "explored and starting point")
     opt = best[1]
     q = np.asarray(opt.x, float)
     final = full.evaluate(tuple(q.tolist()))

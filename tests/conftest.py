@@ -7,14 +7,6 @@ import os
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-# Most of the suite's time is XLA compiling small programs, not running them. The tests check
-# physics, not code generation, so they compile with LLVM's optimisation off (about a third less
-# CPU time on a 2-core machine, for compile- and run-dominated tests alike); library users and the
-# benchmarks keep XLA's default. Set before jax is imported, and inherited by the notebook kernels
-# and command-line subprocesses the tests start. A user's own XLA_FLAGS setting wins.
-if "xla_backend_optimization_level" not in os.environ.get("XLA_FLAGS", ""):
-    os.environ["XLA_FLAGS"] = (os.environ.get("XLA_FLAGS", "") + " --xla_backend_optimization_level=0").strip()
-
 # One compilation cache for the whole run, shared by the two xdist workers and the notebook kernels
 # and command-line subprocesses they start: a program compiled once (the forming step of the small
 # test cases, the cantilever solver) is read back instead of compiled again. A fresh directory per

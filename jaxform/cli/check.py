@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import pathlib
 import sys
-import xml.etree.ElementTree as ET
 
 
 def add_parser(subparsers) -> None:
@@ -30,13 +29,12 @@ def last_frame(folder: pathlib.Path) -> pathlib.Path:
     index = folder / "frames.pvd"
     if not index.is_file():
         raise ValueError(f"{folder} is a folder without frames.pvd: give a 'jaxform run' folder or a mesh file")
-    try:
-        entries = [(float(ds.get("timestep")), ds.get("file")) for ds in ET.parse(index).getroot().iter("DataSet")]
-    except (ET.ParseError, TypeError, ValueError) as err:
-        raise ValueError(f"{index} is not a readable frame index ({err})") from None
-    if not entries:
+    from jaxform.io.frames import read_frame_index
+
+    frames = read_frame_index(index)
+    if not frames:
         raise ValueError(f"{index} lists no frame: the run wrote nothing to check")
-    return folder / max(entries, key=lambda e: e[0])[1]
+    return folder / max(frames, key=frames.get)
 
 
 def run(args) -> int:

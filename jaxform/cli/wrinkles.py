@@ -23,9 +23,10 @@ import pathlib
 import re
 import sys
 import time
-import xml.etree.ElementTree as ET
 
 import numpy as np
+
+from jaxform.io.frames import read_frame_index
 
 PRESETS = {
     "hemisphere": "the paper's hemisphere as a male mould: punch apex up on a flat base plane "
@@ -200,13 +201,7 @@ def _load_run(folder: pathlib.Path) -> _Run:
         case = from_dict(summary["inputs"])
     except ValueError as err:
         raise ValueError(f"{folder / 'summary.json'}: its 'inputs' are not a valid case ({err})") from None
-    frames = {}
-    try:
-        for ds in ET.parse(folder / "frames.pvd").getroot().iter("DataSet"):
-            frames[ds.get("file")] = float(ds.get("timestep"))
-    except (ET.ParseError, TypeError, ValueError) as err:
-        raise ValueError(f"{folder / 'frames.pvd'} is not a readable frame index ({err})") from None
-    return _Run(folder, case, summary, frames)
+    return _Run(folder, case, summary, read_frame_index(folder / "frames.pvd"))
 
 
 def _run_tool(run: _Run, mesh: pathlib.Path, h: float, ply: int):

@@ -40,6 +40,20 @@ def write_json(path, payload: dict) -> pathlib.Path:
     return path
 
 
+def read_frame_index(path) -> dict[str, float]:
+    """The frames a ``.pvd`` index lists: ``{file name: time (s)}`` (what :class:`FrameWriter` wrote).
+
+    Raises ValueError (naming the file) when the index cannot be read.
+    """
+    import xml.etree.ElementTree as ET
+
+    path = pathlib.Path(path)
+    try:
+        return {ds.get("file"): float(ds.get("timestep")) for ds in ET.parse(path).getroot().iter("DataSet")}
+    except (OSError, ET.ParseError, TypeError, ValueError) as err:
+        raise ValueError(f"{path} is not a readable frame index ({err})") from None
+
+
 class FrameWriter:
     """Write frames of one mesh as ``<stem>_<k>.vtu`` plus ``<stem>.pvd`` in a directory.
 

@@ -15,6 +15,8 @@ Pure JAX; the triangle index is built with numpy on the host from concrete array
   search (``lax.while_loop`` over fixed-size batches): exact for every point. ``TriangleIndex(tri)``
   without clusters (e.g. traced triangles) is the brute-force mode of the same search.
 * :func:`nearest_centroids`: uncertified candidates of a *moving* mesh (ply–ply contact).
+* :func:`closest_points_segments`: parameters of the closest points of two segments (edge–edge
+  self-contact; Ericson 5.1.9, parallel segments at the first end of the first).
 """
 from __future__ import annotations
 
@@ -27,15 +29,13 @@ import numpy as np
 from jaxform._pytree import pytree_dataclass, static_field
 
 __all__ = ["EZ", "safe_norm", "safe_normalize", "safe_sqrt", "tiny_sqrt", "safe_div", "closest_point_triangle",
-           "point_triangle_sqdist", "TriangleIndex", "build_triangle_index", "closest_triangle",
-           "closest_point_on_mesh", "nearest_centroids", "quads_to_triangles"]
+           "point_triangle_sqdist", "closest_points_segments", "TriangleIndex", "build_triangle_index",
+           "closest_triangle", "closest_point_on_mesh", "nearest_centroids", "quads_to_triangles"]
 
 EZ = (0.0, 0.0, 1.0)  # the fallback direction of safe_normalize
 
 
-# ---------------------------------------------------------------------------------------------
-# Safe helpers (finite gradients at zero, STYLE habit 5)
-# ---------------------------------------------------------------------------------------------
+# --- Safe helpers (finite gradients at zero, STYLE habit 5) ---
 
 
 def safe_sqrt(x):
@@ -79,9 +79,7 @@ def safe_div(x, y, default=0.0):
     return jnp.where(ok, x / jnp.where(ok, y, 1.0), default)
 
 
-# ---------------------------------------------------------------------------------------------
-# Point–triangle (components-first core, shared by the public routine and the search kernels)
-# ---------------------------------------------------------------------------------------------
+# --- Point–triangle (components-first core, shared by the public routine and the search) ---
 
 
 def _sub(u, v):
@@ -168,6 +166,19 @@ def point_triangle_sqdist(p, a, b, c):
     return jnp.sum(d * d, axis=-1)
 
 
+def closest_points_segments(p0, p1, q0, q1):
+    """``(s, t)`` (...): the closest points ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)`` of two
+    segments ((..., 3) ends, m, broadcast), ``s, t`` in [0, 1]; zero-length segments allowed."""
+    d1, d2, r = p1 - p0, q1 - q0, p0 - q0
+    a, e, b = jnp.sum(d1 * d1, -1), jnp.sum(d2 * d2, -1), jnp.sum(d1 * d2, -1)
+    c, f = jnp.sum(d1 * r, -1), jnp.sum(d2 * r, -1)
+    den = a * e - b * b  # >= 0; ~0 when parallel: s = 0
+    s = jnp.clip(jnp.where(den > 1e-12 * a * e, safe_div(b * f - c * e, den), 0.0), 0.0, 1.0)
+    t = safe_div(b * s + f, e)
+    s = jnp.where(t < 0.0, safe_div(-c, a), jnp.where(t > 1.0, safe_div(b - c, a), s))
+    return jnp.clip(s, 0.0, 1.0), jnp.clip(t, 0.0, 1.0)
+
+
 def _sqdist_soa(p, t):
     """Squared distances for the search: ``p`` 3 arrays (B, 1), ``t`` 9 arrays (B, T) or (1, T)
     (ax, ay, az, bx, ..., cz), m -> (B, T), m²."""
@@ -177,9 +188,7 @@ def _sqdist_soa(p, t):
     return _dot(r, r)
 
 
-# ---------------------------------------------------------------------------------------------
-# Triangle index (host-built) and the certified nearest-triangle search
-# ---------------------------------------------------------------------------------------------
+# --- Triangle index (host-built) and the certified nearest-triangle search ---
 
 
 @pytree_dataclass
@@ -481,9 +490,7 @@ def quads_to_triangles(faces):
     return jnp.concatenate([faces[:, jnp.array([0, 1, 2])], faces[:, jnp.array([0, 2, 3])]], axis=0)
 
 
-# ---------------------------------------------------------------------------------------------
-# Candidate triangles of a moving mesh (uncertified)
-# ---------------------------------------------------------------------------------------------
+# --- Candidate triangles of a moving mesh (uncertified) ---
 
 
 def nearest_centroids(points, centroids, k: int, chunk: int = 1024):

@@ -16,6 +16,16 @@ of the blank, with three differences:
   arc of a hairpin fold of radius ``h / 2`` (``pi h / 2`` long), on a coarse one just the
   triangles around the node, so a fold one element wide is still held apart. Pairs of
   neighbouring plies of a stack are left to their :class:`jaxform.contact.PlyLoad`.
+* edge against edge as well (:func:`edge_contact`): the distance between two triangles is the
+  least of their vertex–face and edge–edge distances, and on a coarse mesh a fold kinks within
+  one element, where an edge passes through the other layer's edge with both its ends well away
+  from that layer (the one-element kinks of Case A at 4 mm: ends 1–9 h from the face crossed).
+  Each edge is a slave against its nearest edge (not sharing a node, not in its reference
+  neighbourhood), pushed apart along the line of the closest points below ``h`` (the edges as
+  cylinders of diameter ``h``, as in explicit codes' edge-to-edge shell contact): unsigned, a
+  conservative penalty (force ``-grad`` of the energy, linear and angular momentum kept),
+  without friction (sliding friction of a layer on a layer is the node–face contact's), each
+  pass with half of the edge's share (a third of each triangle beside it) of the area.
 
 Candidates come from the cell grid of :mod:`jaxform.broadphase`, refreshed when a node has moved
 by half the skin. Differentiable where it is smooth, like the tool contact; the side and the
@@ -23,17 +33,71 @@ candidate table are integers of the state (no gradient).
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
 from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
-from jaxform.contact import ply_contact
-from jaxform.geometry import closest_point_triangle, point_triangle_sqdist
+from jaxform.contact import ContactResult, node_contact, ply_contact
+from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
+                              safe_normalize)
 
-__all__ = ["SelfContactLoad", "self_contact_load"]
+__all__ = ["SelfContactLoad", "self_contact_load", "edge_contact", "mesh_edges"]
+
+
+def _edge_pair(pa, va, qb, vb, gap0, area, params):
+    """One edge (ends ``pa`` (2, 3), velocities ``va``) against its K candidate edges ``qb``, ``vb``
+    (K, 2, 3): the nearest pushed apart along the line of closest points."""
+    s, t = closest_points_segments(pa[0], pa[1], qb[:, 0], qb[:, 1])
+    ca = pa[0] + s[:, None] * (pa[1] - pa[0])
+    cb = qb[:, 0] + t[:, None] * (qb[:, 1] - qb[:, 0])
+    j = jnp.argmin(jnp.sum((ca - cb) ** 2, axis=-1))
+    s, t, d = s[j], t[j], ca[j] - cb[j]
+    v_rel = (1.0 - s) * va[0] + s * va[1] - (1.0 - t) * vb[j, 0] - t * vb[j, 1]
+    f, p, g, e, _ = node_contact(safe_norm(d), safe_normalize(d), v_rel, gap0, area, params)
+    return f, s, t, j, p, g, e
+
+
+def edge_contact(x, v, edges, candidates, gap0, area, params) -> ContactResult:
+    """Edge-to-edge contact: each edge of ``edges`` (E, 2) int against the nearest of its
+    ``candidates`` (E, K) int edges, pushed apart below the distance ``gap0`` (m) along the line
+    of the closest points, with the penalty and normal damping of ``params`` (friction ignored).
+
+    Args:
+        x, v: (N, 3) node positions (m) and velocities (m/s); area: () or (E,) m² per edge.
+
+    Returns:
+        :class:`jaxform.contact.ContactResult` with ``force`` (N, 3), ``pressure``/``gap`` (E,).
+    """
+    e = jnp.asarray(edges)
+    cand = jnp.asarray(candidates)
+    area = jnp.broadcast_to(jnp.asarray(area, x.dtype), e.shape[:1])
+    nofric = dataclasses.replace(params, friction=0.0)
+    eb = e[cand]  # (E, K, 2)
+    f, s, t, j, p, g, en = jax.vmap(_edge_pair, in_axes=(0, 0, 0, 0, None, 0, None))(
+        x[e], v[e], x[eb], v[eb], jnp.asarray(gap0, x.dtype), area, nofric)
+    other = jnp.take_along_axis(eb, j[:, None, None], axis=1)[:, 0]  # (E, 2)
+    w = jnp.stack([1.0 - s, s, t - 1.0, -t], axis=1)  # a0, a1 get +f; b0, b1 get -f
+    idx = jnp.concatenate([e, other], axis=1)
+    force = jnp.zeros_like(x).at[idx.reshape(-1)].add((w[:, :, None] * f[:, None, :]).reshape(-1, 3))
+    return ContactResult(force=force, reaction=jnp.zeros(3, x.dtype), pressure=p, gap=g, energy=jnp.sum(en),
+                         friction_power=jnp.zeros((), x.dtype))
+
+
+def mesh_edges(tris, tri_area):
+    """``(edges (E, 2) int64, share (E,), tri_edges (F, 3) int64)``: the unique edges of triangles
+    ``tris`` (F, 3), a third of the area ``tri_area`` (F,) of each triangle beside them (shares sum
+    to the area), and the edges of each triangle."""
+    tris = np.asarray(tris, np.int64)
+    all_e = np.sort(np.concatenate([tris[:, [0, 1]], tris[:, [1, 2]], tris[:, [2, 0]]]), axis=1)
+    edges, inv = np.unique(all_e, axis=0, return_inverse=True)
+    share = np.bincount(inv.reshape(-1), weights=np.tile(np.asarray(tri_area, np.float64) / 3.0, 3),
+                        minlength=len(edges))
+    return edges, share, inv.reshape(3, -1).T
 
 
 @pytree_dataclass
@@ -52,7 +116,11 @@ class SelfContactLoad:
         x0: (N, 3) reference positions, m; c0: (F, 3) reference centroids, m;
         exclusion: () own-neighbourhood distance, m.
         fallback: (N,) int32 a triangle each node may touch, far away in the reference.
-        skin: () m; k, refresh_every, cap: static ints.
+        edges: (E, 2) int32 the edges of ``triangles``; edge_area: (E,) half their area share, m²;
+        edge_group: (E,) int32 ply; edge_fallback: (E,) int32 a far edge of the same ply;
+        tri_edges: (F, 3) int32 the edges of each triangle.
+        skin: () m; k (candidate triangles per node), edge_k (candidate edges per edge),
+        refresh_every, cap: static ints.
     """
 
     slave: Any
@@ -67,8 +135,14 @@ class SelfContactLoad:
     c0: Any
     exclusion: Any
     fallback: Any
+    edges: Any
+    edge_area: Any
+    edge_group: Any
+    edge_fallback: Any
+    tri_edges: Any
     skin: Any
     k: int = static_field(default=8)
+    edge_k: int = static_field(default=4)
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=32)
 
@@ -87,16 +161,46 @@ class SelfContactLoad:
         near = (g == tg) & (d2 < self.exclusion**2)
         return self.pair_ok[g, tg] & ~near
 
+    def _seg_d2(self, x, a, b):
+        pa, pb = x[self.edges[a]][:, None], x[self.edges[b]]  # (B, 1, 2, 3), (B, M, 2, 3)
+        s, t = closest_points_segments(pa[..., 0, :], pa[..., 1, :], pb[..., 0, :], pb[..., 1, :])
+        d = pa[..., 0, :] + s[..., None] * (pa[..., 1, :] - pa[..., 0, :]) - pb[..., 0, :] - t[..., None] * (
+            pb[..., 1, :] - pb[..., 0, :])
+        return jnp.sum(d * d, axis=-1)
+
+    def edge_allowed(self, a, b):
+        """(B, M) bool: edges ``a`` (B,) and ``b`` (B, M) may touch: their plies may, they share no
+        node, and they are not closer than ``exclusion`` in the reference (same ply)."""
+        ea, eb = self.edges[a][:, None, :, None], self.edges[b][:, :, None, :]
+        g, gb = self.edge_group[a][:, None], self.edge_group[b]
+        near = (g == gb) & (self._seg_d2(self.x0, a, b) < self.exclusion**2)
+        return self.pair_ok[g, gb] & ~jnp.any(ea == eb, axis=(2, 3)) & ~near
+
+    def edge_candidates(self, x, node_ids):
+        """(E, edge_k) int32: for each edge, the nearest (exact distance at ``x`` (N, 3)) of the
+        edges of the triangles that are candidates (``node_ids`` (N, k), unsided) of its two ends:
+        the node search's grid serves the edges too (an edge within reach of another lies in a
+        triangle near one of its ends)."""
+        e = jnp.arange(self.edges.shape[0], dtype=jnp.int32)
+        tri = node_ids[self.edges].reshape(e.shape[0], -1)  # (E, 2k)
+        cand = self.tri_edges[tri].reshape(e.shape[0], -1)  # (E, 6k)
+        d2 = jnp.where(self.edge_allowed(e, cand), self._seg_d2(x, e, cand), jnp.inf)
+        neg, j = jax.lax.top_k(-d2, self.edge_k)
+        best = jnp.take_along_axis(cand, j, axis=1)
+        return jnp.where(jnp.isfinite(neg), best, self.edge_fallback[:, None]).astype(jnp.int32)
+
     def search(self, x):
-        """``(candidates (N, k) int32 with sides, overflow ())`` for positions ``x`` (N, 3)."""
+        """``((node candidates (N, k) int32 with sides, edge candidates (E, edge_k) int32), overflow ())``
+        for positions ``x`` (N, 3)."""
         tri_x = x[self.triangles]
         ids, _, over = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
                                              refine=self.allowed, fallback=self.fallback, cap=self.cap)
+        eids = self.edge_candidates(x, ids)
         t = tri_x[ids]  # (N, k, 3, 3)
         q, _ = closest_point_triangle(x[:, None, :], t[..., 0, :], t[..., 1, :], t[..., 2, :])
         nrm = jnp.cross(t[..., 1, :] - t[..., 0, :], t[..., 2, :] - t[..., 0, :])
         front = jnp.sum((x[:, None, :] - q) * nrm, axis=-1) >= 0
-        return jnp.where(front, ids, ~ids).astype(jnp.int32), over
+        return (jnp.where(front, ids, ~ids).astype(jnp.int32), eids), over
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
@@ -104,15 +208,18 @@ class SelfContactLoad:
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self.skin, self.refresh_every)
-        res = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, self.params)
-        extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
-                  "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes, "search_overflow": st.overflow,
-                  "min_gap": jnp.min(res.gap)}
-        return res.force, st, extras
+        nodes, edges = st.candidates
+        res = ply_contact(x, v, self.slave, self.triangles, nodes, self.gap0, self.area, self.params)
+        ee = edge_contact(x, v, self.edges, edges, self.gap0, self.edge_area, self.params)
+        extras = {"contact_energy": res.energy + ee.energy, "friction_power": res.friction_power,
+                  "max_pressure": jnp.maximum(jnp.max(res.pressure), jnp.max(ee.pressure)), "refreshes": st.refreshes,
+                  "search_overflow": st.overflow, "min_gap": jnp.min(res.gap), "min_edge_gap": jnp.min(ee.gap)}
+        return res.force + ee.force, st, extras
 
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
-                      skin=None, k: int = 8, refresh_every: int = 200, cap: int = 32, dtype=jnp.float32):
+                      skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 32,
+                      dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
 
     Args:
@@ -122,7 +229,7 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         pair_ok: (G, G) bool plies allowed to touch (default all; index by ``group``).
         exclusion: own-neighbourhood distance, m (default ``2 h``).
         skin: search margin beyond ``h``, m (default ``h``): refresh when a node moved ``skin / 2``.
-        k, refresh_every, cap: see :class:`SelfContactLoad`.
+        k, edge_k, refresh_every, cap: see :class:`SelfContactLoad`.
     """
     x0 = np.asarray(x0, np.float64)
     tris = np.asarray(tris, np.int64)
@@ -132,23 +239,35 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
     ok = np.ones((n_groups, n_groups), bool) if pair_ok is None else np.asarray(pair_ok, bool)
     c0 = x0[tris].mean(axis=1)
     tg = group[tris[:, 0]]
-    # fallback: of the four extreme triangles of the node's own ply (corners of the blank), the
-    # farthest from the node in the reference
-    fallback = np.zeros(len(x0), np.int64)
-    best = np.full(len(x0), -1.0)
-    for g in np.unique(group):
-        ids = np.nonzero(tg == g)[0]
-        nodes = np.nonzero(group == g)[0]
-        for s in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
-            t = ids[np.argmax(s[0] * c0[ids, 0] + s[1] * c0[ids, 1])]
-            d = np.linalg.norm(x0[nodes] - c0[t], axis=1)
-            better = d > best[nodes]
-            best[nodes[better]] = d[better]
-            fallback[nodes[better]] = t
+    edges, share, tri_edges = mesh_edges(tris, 0.5 * np.linalg.norm(np.cross(x0[tris[:, 1]] - x0[tris[:, 0]],
+                                                                  x0[tris[:, 2]] - x0[tris[:, 0]]), axis=1))
+    m0 = x0[edges].mean(axis=1)
+    eg = group[edges[:, 0]]
     as_f = lambda a: jnp.asarray(a, dtype)  # noqa: E731
+    as_i = lambda a: jnp.asarray(a, jnp.int32)  # noqa: E731
     return SelfContactLoad(
-        slave=jnp.arange(len(x0), dtype=jnp.int32), triangles=jnp.asarray(tris, jnp.int32), gap0=as_f(h),
-        area=as_f(0.5 * np.asarray(node_area, np.float64)), params=params, group=jnp.asarray(group, jnp.int32),
-        tri_group=jnp.asarray(tg, jnp.int32), pair_ok=jnp.asarray(ok), x0=as_f(x0), c0=as_f(c0),
-        exclusion=as_f(2.0 * h if exclusion is None else exclusion), fallback=jnp.asarray(fallback, jnp.int32),
-        skin=as_f(h if skin is None else skin), k=k, refresh_every=refresh_every, cap=cap)
+        slave=jnp.arange(len(x0), dtype=jnp.int32), triangles=as_i(tris), gap0=as_f(h),
+        area=as_f(0.5 * np.asarray(node_area, np.float64)), params=params, group=as_i(group),
+        tri_group=as_i(tg), pair_ok=jnp.asarray(ok), x0=as_f(x0), c0=as_f(c0),
+        exclusion=as_f(2.0 * h if exclusion is None else exclusion), fallback=as_i(_far(x0, group, c0, tg)),
+        edges=as_i(edges), edge_area=as_f(0.5 * share), edge_group=as_i(eg),
+        edge_fallback=as_i(_far(m0, eg, m0, eg)), tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin), k=k, edge_k=edge_k,
+        refresh_every=refresh_every, cap=cap)
+
+
+def _far(p, pg, c, cg):
+    """(P,) int: for each point ``p`` (P, 3) of ply ``pg``, the farthest in the reference of the four
+    extreme (corner) items of its own ply (centres ``c`` (M, 3), plies ``cg``): a fallback candidate
+    that is beyond reach whenever a slot is empty."""
+    out = np.zeros(len(p), np.int64)
+    best = np.full(len(p), -1.0)
+    for g in np.unique(pg):
+        ids = np.nonzero(cg == g)[0]
+        pts = np.nonzero(pg == g)[0]
+        for sx, sy in ((1, 1), (1, -1), (-1, 1), (-1, -1)):
+            t = ids[np.argmax(sx * c[ids, 0] + sy * c[ids, 1])]
+            d = np.linalg.norm(p[pts] - c[t], axis=1)
+            better = d > best[pts]
+            best[pts[better]] = d[better]
+            out[pts[better]] = t
+    return out

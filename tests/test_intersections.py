@@ -1,6 +1,8 @@
 """The intersection checker (issue 19): a fold through itself is found, a fold lying on itself at
-the contact distance is not, neighbouring faces are never counted; the CLI on files and runs."""
+the contact distance is not, neighbouring faces are never counted; warped quads as the solver
+split them; the CLI on files and runs."""
 import json
+import pathlib
 
 import meshio
 import numpy as np
@@ -121,3 +123,31 @@ def test_tiny_meshes(n):
     nodes[1, 0] = nodes[2, 1] = 1.0
     faces = np.zeros((0, 3), int) if n == 0 else np.array([[0, 1, 2]])
     assert intersecting_pairs(nodes, faces).shape == (0, 2)
+
+
+def test_a_warped_quad_is_checked_as_the_solver_split_it():
+    # quad A with corners 1 and 3 raised: split along 0-2 it is a valley, along 1-3 a ridge; a
+    # vertical fin over the 0-2 diagonal crosses the ridge only
+    nodes = np.array([[0.0, 0, 0], [1, 0, 1], [1, 1, 0], [0, 1, 1],
+                      [0.1, 0.1, 0.25], [0.9, 0.9, 0.25], [0.9, 0.9, 0.75], [0.1, 0.1, 0.75]])
+    quads = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+    assert len(intersecting_pairs(nodes, quads)) == 0
+    split = np.array([[0, 1, 3], [1, 2, 3], [4, 5, 6], [4, 6, 7]])
+    assert intersecting_pairs(nodes, quads, triangles=split).tolist() == [[0, 1]]
+    with pytest.raises(ValueError, match="triangles of shape"):
+        intersecting_pairs(nodes, quads, triangles=split[:3])
+
+
+def test_a_run_folder_is_checked_with_the_rig_triangles():
+    from jaxform import cases
+    from jaxform.cli.check import _run_triangles
+    from jaxform.forming import rig
+
+    case = cases.with_element_size(cases.load("case-b-woven-nlbm"), 25e-3)
+    mesh = rig.build_mesh(case)
+    n = int(round(np.sqrt(mesh.n_nodes / 2)))
+    quads = rig.grid_quads(n, n, 2)
+    ply = np.repeat([1, 2], mesh.n_nodes // 2)
+    tris = _run_triangles(pathlib.Path("."), np.asarray(mesh.nodes), quads, ply)
+    np.testing.assert_array_equal(tris, np.asarray(mesh.tris))
+    assert _run_triangles(pathlib.Path("."), np.asarray(mesh.nodes), quads[::-1], ply) is None  # not a rig grid

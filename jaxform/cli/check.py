@@ -3,7 +3,8 @@
 Reads the last frame of a ``jaxform run`` folder (the ``frames.pvd`` entry with the largest time)
 or any surface mesh meshio reads (VTU, OBJ, PLY, STL, Abaqus .inp, ...), and lists the pairs of
 faces that cross each other (:func:`jaxform.metrics.intersections.intersecting_pairs`: faces
-sharing an edge, and touching layers, are not intersections). Exit status 0: none; 1: some
+sharing an edge, and touching layers, are not intersections). A run's quads are split into the
+triangles it was simulated with; other quad meshes along their 0-2 diagonal. Exit status 0: none; 1: some
 found; 2: bad input. ``--json FILE`` writes the pairs and counts.
 """
 from __future__ import annotations
@@ -37,6 +38,22 @@ def last_frame(folder: pathlib.Path) -> pathlib.Path:
     return folder / max(frames, key=frames.get)
 
 
+def _run_triangles(path, nodes, faces, ply):
+    """The triangles a ``jaxform run`` folder's blank was simulated with (its quads are split along
+    alternating diagonals, :func:`jaxform.forming.rig.grid_triangles`), or None for other meshes."""
+    if not path.is_dir() or faces.shape[1] != 4 or ply is None:
+        return None
+    import numpy as np
+
+    from jaxform.forming.rig import grid_quads, grid_triangles
+
+    plies = len(np.unique(ply))
+    n = int(round(np.sqrt(len(nodes) / plies)))
+    if n * n * plies != len(nodes) or not np.array_equal(grid_quads(n, n, plies), faces):
+        return None
+    return grid_triangles(n, plies)
+
+
 def run(args) -> int:
     import numpy as np
 
@@ -49,8 +66,8 @@ def run(args) -> int:
         raise FileNotFoundError(f"no such run folder or mesh file: {path}")
     mesh = last_frame(path) if path.is_dir() else path
     nodes, faces, data = read_surface(mesh, units="m", on_units_mismatch="ignore", point_data=True)
-    pairs = intersecting_pairs(nodes, faces)
     ply = np.asarray(data["ply_id"]).reshape(len(nodes), -1)[:, 0].astype(int) if "ply_id" in data else None
+    pairs = intersecting_pairs(nodes, faces, triangles=_run_triangles(path, nodes, faces, ply))
     counts = {}
     if ply is not None and len(pairs):
         fp = ply[faces[:, 0]]

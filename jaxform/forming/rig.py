@@ -138,6 +138,19 @@ def grid_quads(nx: int, ny: int, plies: int = 1) -> np.ndarray:
     return np.concatenate([one + k * nx * ny for k in range(plies)]).astype(np.int64)
 
 
+def grid_triangles(n: int, plies: int = 1) -> np.ndarray:
+    """(2Q, 3) int64 triangles of :func:`grid_quads` ``(n, n, plies)``, quad ``q`` split into
+    ``2q, 2q + 1`` along alternating diagonals (union jack; :func:`build_mesh`)."""
+    quads = grid_quads(n, n)
+    i, j = np.meshgrid(np.arange(n - 1), np.arange(n - 1), indexing="xy")
+    even = ((i + j) % 2 == 0).ravel()
+    p, q, s, r = quads[:, 0], quads[:, 1], quads[:, 2], quads[:, 3]
+    t1 = np.where(even[:, None], np.stack([p, q, s], 1), np.stack([p, q, r], 1))
+    t2 = np.where(even[:, None], np.stack([p, s, r], 1), np.stack([q, s, r], 1))
+    one = np.stack([t1, t2], 1).reshape(-1, 3)
+    return np.concatenate([one + k * n * n for k in range(plies)]).astype(np.int64)
+
+
 def build_mesh(case: Case) -> Mesh:
     """The blank: one ``blank_size`` square of about ``element_size`` quads per ply, ply 1 on top (m).
 
@@ -154,15 +167,7 @@ def build_mesh(case: Case) -> Mesh:
     nodes = np.array(mesh.nodes, dtype=np.float64)
     for (a, b), z in zip(mesh.ply_nodes, ply_heights(case)):
         nodes[a:b, 2] = z
-    quads = grid_quads(nq + 1, nq + 1)
-    i, j = np.meshgrid(np.arange(nq), np.arange(nq), indexing="xy")
-    even = ((i + j) % 2 == 0).ravel()
-    p, q, s, r = quads[:, 0], quads[:, 1], quads[:, 2], quads[:, 3]
-    t1 = np.where(even[:, None], np.stack([p, q, s], 1), np.stack([p, q, r], 1))
-    t2 = np.where(even[:, None], np.stack([p, s, r], 1), np.stack([q, s, r], 1))
-    tris1 = np.stack([t1, t2], 1).reshape(-1, 3)
-    npp = (nq + 1) ** 2
-    tris = np.concatenate([tris1 + k * npp for k in range(n)]).astype(np.int32)
+    tris = grid_triangles(nq + 1, n).astype(np.int32)
     e1 = nodes[tris[:, 1]] - nodes[tris[:, 0]]
     e2 = nodes[tris[:, 2]] - nodes[tris[:, 0]]
     area = 0.5 * np.linalg.norm(np.cross(e1, e2), axis=1)
@@ -393,9 +398,9 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
                                  fibre_mass_factor=fms)
     x0 = jnp.asarray(mesh.nodes, jdtype)
-    load_states = [None, None, holder_state] + [ld.initial_state(x0) for ld in loads[3:]]
-    # jitted: eager (op-by-op) evaluation of the shell forces costs seconds
-    state = _init_state(model, tuple(load_states))
+    # jitted: eager (op-by-op) evaluation of the shell forces and of the contact searches costs
+    # seconds to minutes (each operation compiled on its own)
+    state = _init_state(model, holder_state, x0)
     mid, corners = _edge_nodes(mesh, mesh.ply_nodes[0][0])
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
@@ -405,7 +410,8 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
 
 
 @jax.jit
-def _init_state(model, load_states):
+def _init_state(model, holder_state, x0):
+    load_states = (None, None, holder_state) + tuple(ld.initial_state(x0) for ld in model.loads[3:])
     return integrate.init_state(model, load_states=load_states)
 
 

@@ -91,12 +91,15 @@ def _cross_pairs(p, q, ea, eb):
     return hit
 
 
-def intersecting_pairs(nodes, faces, *, chunk: int = 200_000) -> np.ndarray:
+def intersecting_pairs(nodes, faces, *, triangles=None, chunk: int = 200_000) -> np.ndarray:
     """Pairs of faces of a mesh that pass through each other.
 
     Args:
         nodes: (N, 3) node positions (any length unit: the test is scale-free).
         faces: (F, 3) triangles or (F, 4) quads (split along their 0-2 diagonal), int.
+        triangles: optional (2F, 3) int the quads' own split, quad ``q`` into triangles ``2q`` and
+            ``2q + 1`` (a warped quad is two different surfaces split one way or the other: give
+            the split the solver used, e.g. :func:`jaxform.forming.rig.grid_triangles`).
         chunk: candidate pairs tested at a time (memory).
 
     Returns:
@@ -105,7 +108,13 @@ def intersecting_pairs(nodes, faces, *, chunk: int = 200_000) -> np.ndarray:
     x = np.asarray(nodes, np.float64)
     if x.ndim != 2 or x.shape[1] != 3:
         raise ValueError(f"nodes of shape {x.shape}: need (N, 3)")
-    tris, owner = triangulate(faces)
+    if triangles is None:
+        tris, owner = triangulate(faces)
+    else:
+        tris = np.asarray(triangles, np.int64)
+        if np.shape(faces)[1] != 4 or tris.shape != (2 * len(faces), 3):
+            raise ValueError(f"triangles of shape {tris.shape} for faces of shape {np.shape(faces)}: need (2F, 3) for quads")
+        owner = np.arange(len(tris)) // 2
     if len(tris) and (tris.min() < 0 or tris.max() >= len(x)):
         raise ValueError(f"faces refer to nodes {tris.min()}..{tris.max()} but there are {len(x)} nodes")
     p = x[tris]

@@ -257,6 +257,20 @@ def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None,
     return _freeze_if_failed(state, end), jax.tree_util.tree_map(lambda a: a[-1], extras)
 
 
+def advance(model: Model, state: State, n, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5,
+            energy_floor: float = 0.0) -> State:
+    """``n`` steps, ``n`` an integer that may be traced (a ``lax.fori_loop`` with a dynamic trip
+    count): one compiled program for any number of steps, so a driver's stretches of different
+    lengths (and runs of different strokes or frame counts on the same rig) share it. Forward only
+    (a while loop has no reverse mode): differentiate through :func:`run_steps`/:func:`rollout`.
+    A failed stretch returns its starting state with the failure recorded, as :func:`run_steps`.
+    """
+    x_ref = model.drive.position(0.0) if x_ref is None else x_ref
+    e0 = state.energies if e0 is None else e0
+    end = jax.lax.fori_loop(0, n, lambda _, s: _advance(model, s, x_ref, e0, blowup_tol, energy_floor)[0], state)
+    return _freeze_if_failed(state, end)
+
+
 def rollout(model: Model, state: State, n_frames: int, every: int, *, checkpoint: bool = True,
             blowup_tol: float = 0.5, energy_floor: float = 0.0):
     """Run ``n_frames * every`` steps; return ``(final_state, frames)`` (pure, jit-able, differentiable).
@@ -328,4 +342,4 @@ def simulate(model: Model, state: State | None = None, *, n_frames: int, every: 
     return s, frames
 
 
-__all__ = ["make_model", "init_state", "step", "run_steps", "rollout", "simulate", "check", "failure_cause", "describe_failure", "Frames", "SimulationError"]
+__all__ = ["make_model", "init_state", "step", "run_steps", "advance", "rollout", "simulate", "check", "failure_cause", "describe_failure", "Frames", "SimulationError"]

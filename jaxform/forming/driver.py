@@ -44,7 +44,11 @@ def run_steps(model, state, e0, x_ref, n: int, energy_floor: float | None = None
     return integrate.run_steps(model, state, n, e0=e0, x_ref=x_ref, blowup_tol=BLOWUP_TOL, energy_floor=floor)[0]
 
 
-_run_steps_jit = jax.jit(run_steps, static_argnames=("n", "energy_floor"))
+@jax.jit
+def _advance_jit(model, state, e0, x_ref, n, energy_floor):
+    """The host driver's stretch of ``n`` steps (traced: one program for a rig, whatever its
+    stroke, frame count or sampling), forward only (:func:`jaxform.integrate.advance`)."""
+    return integrate.advance(model, state, n, e0=e0, x_ref=x_ref, blowup_tol=BLOWUP_TOL, energy_floor=energy_floor)
 
 
 def rollout(model, state, info: RunInfo, *, n_frames: int | None = None, checkpoint: bool = True):
@@ -179,7 +183,8 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     ply_arr = jnp.asarray(info.ply_id)
     n_plies = info.case.n_plies
     e0, x_ref = state.energies, state.x
-    floor = _floor(state)
+    floor = jnp.asarray(_floor(state), state.x.dtype)
+    n_sub = jnp.asarray(info.sub_steps, jnp.int32)
     rec = _Recorder(on_frame)
     complete, reason = False, None
     try:
@@ -189,7 +194,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
         if not build_only:
             for _ in range(info.n_frames - 1):
                 for _ in range(info.samples_per_frame):
-                    new = _run_steps_jit(model, state, e0, x_ref, n=info.sub_steps, energy_floor=floor)
+                    new = _advance_jit(model, state, e0, x_ref, n_sub, floor)
                     if int(new.bad_step) >= 0:
                         raise integrate.SimulationError(
                             integrate.describe_failure(new, model) + " The frames up to the last good one are kept.",

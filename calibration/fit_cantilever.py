@@ -14,7 +14,9 @@ only) and params.json holds ``pos`` and ``neg`` sections. Gravity 9.81 m/s².
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm`` (= b_inf + m0/kappa0),
 ``b_41_5_Nm`` (standard test simulated with the fitted law), ``rmse_mm`` (RMS z-residual at the
 measured x), ``sigma_*`` (Gauss–Newton standard errors), ``kappa_max_over_kappa0`` and
-``b_inf_determined`` (Fisher sd of B_inf under 10 % and the data past 5 kappa0), ``noise_mm`` (read
+``b_inf_determined`` (Fisher sd of B_inf under 10 % and the data past 5 kappa0), ``b_init_sd_pct``
+and ``b_init_determined`` (Fisher sd of B_init under 1 %: a short strip bent far past kappa0 near
+the clamp can leave B_init and kappa0 trading against each other), ``noise_mm`` (read
 off the profile) and ``rmse_over_noise``, ``iterations``, ``wall_time_s``. An existing --out is never overwritten
 without --force.
 
@@ -208,7 +210,10 @@ def _run(args, sides) -> int:
     for side, d in results.items():
         det = "determined" if d["b_inf_determined"] else \
             "UNDETERMINED: its Fisher sd is over 10 % or the data do not reach 5 x kappa0"
-        print(f"[{side}] B_init {d['b_init_Nm']:.4g} ± {d['sigma_b_init_Nm']:.2g} N·m, "
+        det_init = "determined" if d["b_init_determined"] else \
+            "UNDETERMINED: its Fisher sd is over 1 %; this profile does not pin it to 3 %, add a longer overhang"
+        print(f"[{side}] B_init {d['b_init_Nm']:.4g} ± {d['sigma_b_init_Nm']:.2g} N·m "
+              f"({d['b_init_sd_pct']:.1f} %, {det_init}), "
               f"B_inf {d['b_inf_Nm']:.4g} ± {d['sigma_b_inf_Nm']:.2g} N·m ({det}), "
               f"kappa0 {d['kappa0_per_m']:.4g} 1/m, rmse {d['rmse_mm']:.3f} mm ({d['rmse_over_noise']:.2f} x the noise "
               f"{d['noise_mm']:.3f} mm read off the profile), "

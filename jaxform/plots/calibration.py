@@ -40,7 +40,9 @@ def cantilever_fit_figure(fit, profiles, *, title: str = ""):
     axes[2].set_xlabel("curvature, 1/m")
     axes[2].set_ylabel("B = dM/dkappa, N·mm")
     det = "determined" if fit.b_inf_determined else "NOT determined"
-    axes[2].set_title(f"B_init {fit.b_init:.3g} N·m, B_inf {fit.b_inf:.3g} N·m ({det})", fontsize=9)
+    det_init = "" if getattr(fit, "b_init_determined", True) else " NOT determined"
+    axes[2].set_title(f"B_init {fit.b_init:.3g} N·m ± {100 * fit.sigma['b_init'] / fit.b_init:.1f} %{det_init}, "
+                      f"B_inf {fit.b_inf:.3g} N·m ({det})", fontsize=9)
     for a in axes:
         a.grid(alpha=0.3)
     if title:

@@ -15,8 +15,7 @@ Pure JAX; the triangle index is built with numpy on the host from concrete array
   search (``lax.while_loop`` over fixed-size batches): exact for every point. ``TriangleIndex(tri)``
   without clusters (e.g. traced triangles) is the brute-force mode of the same search.
 * :func:`nearest_centroids`: uncertified candidates of a *moving* mesh (ply–ply contact).
-* :func:`closest_points_segments`: parameters of the closest points of two segments (edge–edge
-  self-contact; Ericson 5.1.9, parallel segments at the first end of the first).
+* :func:`closest_points_segments`: closest points of two segments (Ericson 5.1.9; edge–edge contact).
 """
 from __future__ import annotations
 
@@ -168,12 +167,15 @@ def point_triangle_sqdist(p, a, b, c):
 
 def closest_points_segments(p0, p1, q0, q1):
     """``(s, t)`` (...): the closest points ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)`` of two
-    segments ((..., 3) ends, m, broadcast), ``s, t`` in [0, 1]; zero-length segments allowed."""
+    segments ((..., 3) ends, m, broadcast), ``s, t`` in [0, 1]; zero-length segments allowed;
+    parallel ones (to rounding) meet in the middle of their overlap, not at an arbitrary end."""
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
     a, e, b = jnp.sum(d1 * d1, -1), jnp.sum(d2 * d2, -1), jnp.sum(d1 * d2, -1)
     c, f = jnp.sum(d1 * r, -1), jnp.sum(d2 * r, -1)
-    den = a * e - b * b  # >= 0; ~0 when parallel: s = 0
-    s = jnp.clip(jnp.where(den > 1e-12 * a * e, safe_div(b * f - c * e, den), 0.0), 0.0, 1.0)
+    den = a * e - b * b  # >= 0, a e sin^2 of the angle
+    par = den <= 64.0 * jnp.finfo(den.dtype).eps * a * e
+    lo, hi = jnp.maximum(jnp.minimum(-c, b - c), 0.0), jnp.minimum(jnp.maximum(-c, b - c), a)  # overlap, s a
+    s = jnp.clip(jnp.where(par, safe_div(0.5 * (lo + hi), a), safe_div(b * f - c * e, den)), 0.0, 1.0)
     t = safe_div(b * s + f, e)
     s = jnp.where(t < 0.0, safe_div(-c, a), jnp.where(t > 1.0, safe_div(b - c, a), s))
     return jnp.clip(s, 0.0, 1.0), jnp.clip(t, 0.0, 1.0)

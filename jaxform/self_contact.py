@@ -34,7 +34,7 @@ candidate table are integers of the state (no gradient).
 from __future__ import annotations
 
 import dataclasses
-from typing import Any
+from typing import Any, NamedTuple
 
 import jax
 import jax.numpy as jnp
@@ -46,7 +46,32 @@ from jaxform.contact import ContactResult, node_contact, ply_contact
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
                               safe_normalize)
 
-__all__ = ["SelfContactLoad", "self_contact_load", "edge_contact", "mesh_edges"]
+__all__ = ["SelfContactLoad", "Candidates", "self_contact_load", "edge_contact", "mesh_edges"]
+
+
+class Candidates(NamedTuple):
+    """The self-contact's candidate table (fixed shapes), rebuilt with the search.
+
+    Attributes:
+        nodes: (N, k) int32 triangles per node (``~t``: triangle ``t`` from its back).
+        edges: (E, edge_k) int32 edges per edge.
+        active_nodes: (A,) int32, active_edges: (B,) int32: the nodes and edges with a candidate
+            within ``h + skin`` at the refresh, -1 padded: the only ones that can touch before the
+            next (the Verlet criterion), so the only ones evaluated each step.
+        overflow: () bool more of them than ``A`` or ``B``: then every node and edge is evaluated.
+    """
+
+    nodes: Any
+    edges: Any
+    active_nodes: Any
+    active_edges: Any
+    overflow: Any
+
+
+def _compact(mask, size: int):
+    """``(ids (size,) int32, -1 padded; overflow () bool)``: the indices where ``mask`` holds."""
+    ids = jnp.nonzero(mask, size=size, fill_value=-1)[0].astype(jnp.int32)
+    return ids, jnp.sum(mask) > size
 
 
 def _edge_pair(pa, va, qb, vb, gap0, area, params):
@@ -62,22 +87,24 @@ def _edge_pair(pa, va, qb, vb, gap0, area, params):
     return f, s, t, j, p, g, e
 
 
-def edge_contact(x, v, edges, candidates, gap0, area, params) -> ContactResult:
-    """Edge-to-edge contact: each edge of ``edges`` (E, 2) int against the nearest of its
-    ``candidates`` (E, K) int edges, pushed apart below the distance ``gap0`` (m) along the line
-    of the closest points, with the penalty and normal damping of ``params`` (friction ignored).
+def edge_contact(x, v, edges, candidates, gap0, area, params, slave=None) -> ContactResult:
+    """Edge-to-edge contact: each edge of ``edges`` (E, 2) int (or of its subset ``slave`` (S,)
+    int) against the nearest of its ``candidates`` (E or S, K) int edges, pushed apart below the
+    distance ``gap0`` (m) along the line of the closest points, with the penalty and normal
+    damping of ``params`` (friction ignored).
 
     Args:
-        x, v: (N, 3) node positions (m) and velocities (m/s); area: () or (E,) m² per edge.
+        x, v: (N, 3) node positions (m) and velocities (m/s); area: () or (E or S,) m² per edge.
 
     Returns:
-        :class:`jaxform.contact.ContactResult` with ``force`` (N, 3), ``pressure``/``gap`` (E,).
+        :class:`jaxform.contact.ContactResult` with ``force`` (N, 3), ``pressure``/``gap`` (E or S,).
     """
-    e = jnp.asarray(edges)
+    edges = jnp.asarray(edges)
+    e = edges if slave is None else edges[slave]
     cand = jnp.asarray(candidates)
     area = jnp.broadcast_to(jnp.asarray(area, x.dtype), e.shape[:1])
     nofric = dataclasses.replace(params, friction=0.0)
-    eb = e[cand]  # (E, K, 2)
+    eb = edges[cand]  # (E, K, 2)
     f, s, t, j, p, g, en = jax.vmap(_edge_pair, in_axes=(0, 0, 0, 0, None, 0, None))(
         x[e], v[e], x[eb], v[eb], jnp.asarray(gap0, x.dtype), area, nofric)
     other = jnp.take_along_axis(eb, j[:, None, None], axis=1)[:, 0]  # (E, 2)
@@ -104,8 +131,9 @@ def mesh_edges(tris, tri_area):
 class SelfContactLoad:
     """Two-sided fabric–fabric contact of all nodes against all triangles, as an external load.
 
-    ``load_state`` is a :class:`jaxform.broadphase.SearchState`; with ``slave``, ``triangles``,
-    ``gap0``, ``area``, ``params`` and ``load_state[0]`` it evaluates like a
+    ``load_state`` is a :class:`jaxform.broadphase.SearchState` whose ``candidates`` are
+    :class:`Candidates`; with ``slave``, ``triangles``, ``gap0``, ``area``, ``params`` and
+    ``load_state.candidates.nodes`` its node-to-face part evaluates like a
     :class:`jaxform.contact.PlyLoad` (:func:`jaxform.contact.ply_contact`).
 
     Attributes:
@@ -120,7 +148,7 @@ class SelfContactLoad:
         edge_group: (E,) int32 ply; edge_fallback: (E,) int32 a far edge of the same ply;
         tri_edges: (F, 3) int32 the edges of each triangle.
         skin: () m; k (candidate triangles per node), edge_k (candidate edges per edge),
-        refresh_every, cap: static ints.
+        refresh_every, cap, active_cap, edge_active_cap (room in :class:`Candidates`): static ints.
     """
 
     slave: Any
@@ -143,6 +171,8 @@ class SelfContactLoad:
     skin: Any
     k: int = static_field(default=8)
     edge_k: int = static_field(default=4)
+    active_cap: int = static_field(default=1024)
+    edge_active_cap: int = static_field(default=3072)
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=32)
 
@@ -177,30 +207,32 @@ class SelfContactLoad:
         return self.pair_ok[g, gb] & ~jnp.any(ea == eb, axis=(2, 3)) & ~near
 
     def edge_candidates(self, x, node_ids):
-        """(E, edge_k) int32: for each edge, the nearest (exact distance at ``x`` (N, 3)) of the
-        edges of the triangles that are candidates (``node_ids`` (N, k), unsided) of its two ends:
-        the node search's grid serves the edges too (an edge within reach of another lies in a
-        triangle near one of its ends)."""
+        """``(ids (E, edge_k) int32, d2 (E,))``: for each edge, the nearest (exact distance at ``x``
+        (N, 3)) of the edges of the triangles that are candidates (``node_ids`` (N, k), unsided) of
+        its two ends, and its squared distance to the nearest, m²: the node search's grid serves
+        the edges too (an edge within reach of another lies in a triangle near one of its ends)."""
         e = jnp.arange(self.edges.shape[0], dtype=jnp.int32)
         tri = node_ids[self.edges].reshape(e.shape[0], -1)  # (E, 2k)
         cand = self.tri_edges[tri].reshape(e.shape[0], -1)  # (E, 6k)
         d2 = jnp.where(self.edge_allowed(e, cand), self._seg_d2(x, e, cand), jnp.inf)
         neg, j = jax.lax.top_k(-d2, self.edge_k)
         best = jnp.take_along_axis(cand, j, axis=1)
-        return jnp.where(jnp.isfinite(neg), best, self.edge_fallback[:, None]).astype(jnp.int32)
+        return jnp.where(jnp.isfinite(neg), best, self.edge_fallback[:, None]).astype(jnp.int32), -neg[:, 0]
 
     def search(self, x):
-        """``((node candidates (N, k) int32 with sides, edge candidates (E, edge_k) int32), overflow ())``
-        for positions ``x`` (N, 3)."""
+        """``(Candidates, overflow ())`` for positions ``x`` (N, 3)."""
         tri_x = x[self.triangles]
         ids, _, over = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
                                              refine=self.allowed, fallback=self.fallback, cap=self.cap)
-        eids = self.edge_candidates(x, ids)
+        eids, e_d2 = self.edge_candidates(x, ids)
         t = tri_x[ids]  # (N, k, 3, 3)
         q, _ = closest_point_triangle(x[:, None, :], t[..., 0, :], t[..., 1, :], t[..., 2, :])
         nrm = jnp.cross(t[..., 1, :] - t[..., 0, :], t[..., 2, :] - t[..., 0, :])
         front = jnp.sum((x[:, None, :] - q) * nrm, axis=-1) >= 0
-        return (jnp.where(front, ids, ~ids).astype(jnp.int32), eids), over
+        reach2 = (self.gap0 + self.skin) ** 2
+        act_n, full_n = _compact(jnp.min(jnp.sum((x[:, None, :] - q) ** 2, axis=-1), axis=1) <= reach2, self.active_cap)
+        act_e, full_e = _compact(e_d2 <= reach2, self.edge_active_cap)
+        return Candidates(jnp.where(front, ids, ~ids).astype(jnp.int32), eids, act_n, act_e, full_n | full_e), over
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
@@ -208,18 +240,30 @@ class SelfContactLoad:
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self.skin, self.refresh_every)
-        nodes, edges = st.candidates
-        res = ply_contact(x, v, self.slave, self.triangles, nodes, self.gap0, self.area, self.params)
-        ee = edge_contact(x, v, self.edges, edges, self.gap0, self.edge_area, self.params)
-        extras = {"contact_energy": res.energy + ee.energy, "friction_power": res.friction_power,
-                  "max_pressure": jnp.maximum(jnp.max(res.pressure), jnp.max(ee.pressure)), "refreshes": st.refreshes,
-                  "search_overflow": st.overflow, "min_gap": jnp.min(res.gap), "min_edge_gap": jnp.min(ee.gap)}
-        return res.force + ee.force, st, extras
+        c = st.candidates
+
+        def part(nodes, edges):  # the contacts of these nodes and edges (-1: a padding slot)
+            wn, we = nodes >= 0, edges >= 0
+            nodes, edges = jnp.maximum(nodes, 0), jnp.maximum(edges, 0)
+            res = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0, self.area[nodes] * wn,
+                              self.params)
+            ee = edge_contact(x, v, self.edges, c.edges[edges], self.gap0, self.edge_area[edges] * we, self.params,
+                              slave=edges)
+            inf = jnp.asarray(jnp.inf, x.dtype)
+            return res.force + ee.force, {
+                "contact_energy": res.energy + ee.energy, "friction_power": res.friction_power,
+                "max_pressure": jnp.maximum(jnp.max(res.pressure * wn), jnp.max(ee.pressure * we)),
+                "min_gap": jnp.min(jnp.where(wn, res.gap, inf)), "min_edge_gap": jnp.min(jnp.where(we, ee.gap, inf))}
+
+        f, extras = jax.lax.cond(c.overflow, lambda: part(self.slave, jnp.arange(self.edges.shape[0])),
+                                 lambda: part(c.active_nodes, c.active_edges))
+        extras.update(refreshes=st.refreshes, search_overflow=st.overflow, active_overflow=c.overflow.astype(jnp.int32))
+        return f, st, extras
 
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
                       skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 32,
-                      dtype=jnp.float32):
+                      active_fraction: float = 0.125, dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
 
     Args:
@@ -230,6 +274,8 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         exclusion: own-neighbourhood distance, m (default ``2 h``).
         skin: search margin beyond ``h``, m (default ``h``): refresh when a node moved ``skin / 2``.
         k, edge_k, refresh_every, cap: see :class:`SelfContactLoad`.
+        active_fraction: room for the nodes and edges near a candidate at a refresh (evaluated each
+            step; when more are near, all are evaluated).
     """
     x0 = np.asarray(x0, np.float64)
     tris = np.asarray(tris, np.int64)
@@ -251,8 +297,10 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         tri_group=as_i(tg), pair_ok=jnp.asarray(ok), x0=as_f(x0), c0=as_f(c0),
         exclusion=as_f(2.0 * h if exclusion is None else exclusion), fallback=as_i(_far(x0, group, c0, tg)),
         edges=as_i(edges), edge_area=as_f(0.5 * share), edge_group=as_i(eg),
-        edge_fallback=as_i(_far(m0, eg, m0, eg)), tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin), k=k, edge_k=edge_k,
-        refresh_every=refresh_every, cap=cap)
+        edge_fallback=as_i(_far(m0, eg, m0, eg)), tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin),
+        k=k, edge_k=edge_k, refresh_every=refresh_every, cap=cap,
+        active_cap=max(64, int(np.ceil(active_fraction * len(x0)))),
+        edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))))
 
 
 def _far(p, pg, c, cg):

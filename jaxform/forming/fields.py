@@ -91,7 +91,8 @@ def state_fields(model, state, ply_id, n_plies: int):
         phis.append(res.gap + load.offset)
         tool[i] = (res, dz)
     for load, ls in zip(model.loads[3:], state.loads[3:]):
-        res = contact.ply_contact(x, state.v, load.slave, load.triangles, ls[0], load.gap0, load.area, load.params)
+        cand = getattr(ls.candidates, "nodes", ls.candidates)  # self-contact: its node-to-face table
+        res = contact.ply_contact(x, state.v, load.slave, load.triangles, cand, load.gap0, load.area, load.params)
         pressure = pressure.at[load.slave].add(res.pressure)
     out["contact_pressure"] = pressure
     h = jnp.asarray(shell.fabrics[0].thickness, dtype)

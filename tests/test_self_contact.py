@@ -283,9 +283,9 @@ def _squeeze_strip(self_contact, *, length=0.06, width=0.004, n_len=60, gap_h=6.
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(reason="issue 19 done-when 2 not met yet: measured 22 intersecting pairs with node-to-face "
-                   "self-contact against 60 without; edge-edge contact added, not yet measured here", strict=False)
 def test_a_strip_squeezed_between_plates_folds_into_layers_that_do_not_cross():
+    # measured: layers 0.974 h apart at the closest, 0 crossing pairs; 31 without self-contact
+    # (node-to-face contact alone: 22, the edges of one-element kinks passing through each other)
     from jaxform.metrics.intersections import intersecting_pairs
 
     x, mesh, h, sc = _squeeze_strip(True)

@@ -172,10 +172,9 @@ def closest_points_segments(p0, p1, q0, q1):
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
     a, e, b = jnp.sum(d1 * d1, -1), jnp.sum(d2 * d2, -1), jnp.sum(d1 * d2, -1)
     c, f = jnp.sum(d1 * r, -1), jnp.sum(d2 * r, -1)
-    den = a * e - b * b  # >= 0, a e sin^2 of the angle
-    par = den <= 64.0 * jnp.finfo(den.dtype).eps * a * e
+    par = a * e - b * b <= 64.0 * jnp.finfo(a.dtype).eps * a * e  # sin^2 of the angle ~ 0: parallel
     lo, hi = jnp.maximum(jnp.minimum(-c, b - c), 0.0), jnp.minimum(jnp.maximum(-c, b - c), a)  # overlap, s a
-    s = jnp.clip(jnp.where(par, safe_div(0.5 * (lo + hi), a), safe_div(b * f - c * e, den)), 0.0, 1.0)
+    s = jnp.clip(jnp.where(par, safe_div(0.5 * (lo + hi), a), safe_div(b * f - c * e, a * e - b * b)), 0.0, 1.0)
     t = safe_div(b * s + f, e)
     s = jnp.where(t < 0.0, safe_div(-c, a), jnp.where(t > 1.0, safe_div(b - c, a), s))
     return jnp.clip(s, 0.0, 1.0), jnp.clip(t, 0.0, 1.0)

@@ -2,7 +2,8 @@
 
 Pure functions on arrays (no files, no printing): :mod:`~jaxform.calibrate.transforms` (the
 law parameters and the strips' similarity), :mod:`~jaxform.calibrate.cantilever_data` (noise, bending
-length and clamp moment read off a profile), :mod:`~jaxform.calibrate.cantilever_fit` (bending laws through the
+length and clamp moment read off a profile), :mod:`~jaxform.calibrate.profiles` (a simulated profile at
+the measured points, its curvature), :mod:`~jaxform.calibrate.cantilever_fit` (bending laws through the
 shell cantilever, on ``scipy.optimize.least_squares``) and :mod:`~jaxform.calibrate.shear_fit`
 (shear laws, checked on the shell's picture frame). The scripts in ``calibration/`` and the readers
 in :mod:`jaxform.io.calibration_files` sit on top. SI units throughout.
@@ -14,13 +15,12 @@ from jaxform.calibrate.cantilever_fit import (
     FitProgress,
     Profile,
     bounds,
-    discrete_curvature,
     estimate_noise,
     fit_cantilever,
     initial_guess,
-    interp_profile,
     peirce_b,
 )
+from jaxform.calibrate.profiles import discrete_curvature, interp_profile
 from jaxform.calibrate.shear_fit import (
     ShearFit,
     check_shear_fit,

@@ -18,9 +18,9 @@ from jaxform.forming.driver import ENERGY_FLOOR, FormingResult, rollout, run, ru
 from jaxform.forming.fields import node_average, state_fields
 from jaxform.forming.rig import (Rig, RunInfo, build, build_fabric, build_mesh, build_tools, grid_quads, ply_fabrics,
                                  punch_motion, stroke_time, with_fabric)
-from jaxform.forming.summary import draw_in, flange_mask, flange_profile, summarize, symmetry_error, wrinkle_count
+from jaxform.forming.summary import draw_in, flange_census, flange_mask, summarize, symmetry_error
 
 __all__ = ["Case", "ply_heights", "Rig", "RunInfo", "build", "build_fabric", "build_mesh", "build_tools", "grid_quads",
            "ply_fabrics", "punch_motion", "stroke_time", "with_fabric", "node_average", "state_fields", "ENERGY_FLOOR",
-           "FormingResult", "rollout", "run", "run_steps", "simulate", "draw_in", "flange_mask", "flange_profile",
-           "summarize", "symmetry_error", "wrinkle_count"]
+           "FormingResult", "rollout", "run", "run_steps", "simulate", "draw_in", "flange_census", "flange_mask",
+           "summarize", "symmetry_error"]

@@ -1,4 +1,4 @@
-"""What a forming run says, on the host (numpy): draw-in, flange profile and wrinkle count,
+"""What a forming run says, on the host (numpy): draw-in, the flange's wrinkle census,
 mirror symmetry, and the JSON-ready summary (SPEC section 6 keys)."""
 from __future__ import annotations
 
@@ -34,36 +34,14 @@ def flange_mask(x_ref, case) -> np.ndarray:
     return r > float(case.tools.die_opening_radius + case.tools.die_fillet)
 
 
-def flange_profile(x, deviation, radius: float, n_samples: int = 720):
-    """Deviation (m) along a circle of ``radius`` (m) about the punch axis, current configuration:
-    ``(angles (n,) rad, values (n,))``, linearly interpolated in the top view of the nodes ``x``
-    (give one ply's nodes; nearest node where the circle leaves the blank)."""
-    from scipy.interpolate import griddata
+def flange_census(x, deviation, faces, case) -> list:
+    """The wrinkles of one ply's flange (:func:`jaxform.metrics.census.wrinkle_census` from the
+    die opening's fillet outwards): ``x`` (N, 3) its nodes, ``deviation`` (N,) m, ``faces``
+    (F, 3|4) its faces (indices into ``x``)."""
+    from jaxform.metrics.census import wrinkle_census
 
-    x = np.asarray(x, dtype=np.float64)
-    dev = np.asarray(deviation, dtype=np.float64)
-    th = np.linspace(0, 2 * np.pi, n_samples, endpoint=False)
-    pts = np.stack([radius * np.cos(th), radius * np.sin(th)], 1)
-    vals = griddata(x[:, :2], dev, pts, method="linear")
-    bad = ~np.isfinite(vals)
-    if np.any(bad):
-        vals[bad] = griddata(x[:, :2], dev, pts[bad], method="nearest")
-    return th, vals
-
-
-def wrinkle_count(x, deviation, case, *, radius: float | None = None, prominence: float = 0.5e-3,
-                  n_samples: int = 720) -> int:
-    """Number of discrete out-of-plane waves around the flange: peaks of the deviation along a
-    circle of ``radius`` (default 10 mm outside the die fillet) standing out by more than
-    ``prominence`` (m) from the troughs beside them. A flange lifted uniformly counts 0."""
-    from scipy.signal import find_peaks
-
-    rad = float(case.tools.die_opening_radius + case.tools.die_fillet) + 10e-3 if radius is None else radius
-    _, prof = flange_profile(x, deviation, rad, n_samples)
-    prof = np.round(prof, 9)  # no peaks from float noise on flat stretches
-    ext = np.concatenate([prof, prof, prof])
-    peaks, _ = find_peaks(ext, prominence=prominence)
-    return int(np.sum((peaks >= n_samples) & (peaks < 2 * n_samples)))
+    return wrinkle_census(x, deviation, faces=faces,
+                          r_inner=float(case.tools.die_opening_radius + case.tools.die_fillet))
 
 
 def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
@@ -107,6 +85,12 @@ def summarize(result) -> dict:
     dev = result.fields.get("deviation")
     flange = flange_mask(info.x0, case)
     max_dev = float(np.max(dev[-1][flange])) if dev is not None and len(dev) else None
+    census = None
+    if dev is not None and len(dev):
+        top = result.ply_id == 1
+        local = np.cumsum(top) - 1  # node index within ply 1
+        faces = result.faces[np.all(top[result.faces], axis=1)]
+        census = flange_census(result.x[-1][top], dev[-1][top], local[faces], case)
     s = {
         "complete": bool(result.complete),
         "reason": result.reason,
@@ -123,8 +107,8 @@ def summarize(result) -> dict:
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,
-        "flange_wrinkles": (wrinkle_count(result.x[-1][result.ply_id == 1], dev[-1][result.ply_id == 1], case)
-                            if dev is not None and len(dev) else None),
+        "flange_wrinkles": None if census is None else len(census),
+        "wrinkles": None if census is None else [w.to_dict() for w in census],
         "draw_in": di,
         "wall_time_s": result.wall_time_s,
         "frames_written": int(len(result.t)),
@@ -140,4 +124,4 @@ def summarize(result) -> dict:
     return s
 
 
-__all__ = ["draw_in", "flange_mask", "flange_profile", "wrinkle_count", "symmetry_error", "summarize"]
+__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "summarize"]

@@ -8,6 +8,8 @@
   :func:`kappa_max` (eq. 2).
 - :mod:`jaxform.metrics.wrinkles`: ``d_crit``, zones (wrinkle / bridging / conforming), wrinkle
   radius, sections and their normalised RMSE, wrinkle counts, ``M_f^RMS`` and densities.
+- :func:`wrinkle_census` (:mod:`jaxform.metrics.census`): the wrinkles of a flange as an engineer
+  counts them (ridges of the deviation traced across it), each with position, size and amplitude.
 """
 from jaxform.metrics.curvature import (
     CurvatureStencil,
@@ -17,6 +19,7 @@ from jaxform.metrics.curvature import (
     kappa_max,
     principal_curvatures,
 )
+from jaxform.metrics.census import Wrinkle, wrinkle_census
 from jaxform.metrics.distance import (
     HemisphereRig,
     PlaneTool,
@@ -70,4 +73,6 @@ __all__ = [
     "ToolWarning",
     "build_tool_index",
     "tool_distance",
+    "Wrinkle",
+    "wrinkle_census",
 ]

@@ -28,7 +28,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["cell_size", "grid_keys", "neighbour_slots", "candidates", "moved_beyond", "SearchState", "initial_search_state",
+__all__ = ["cell_size", "grid_keys", "neighbour_slots", "candidates", "moved_beyond", "SearchState", "initial_search_state", "initial_state_of",
            "refreshed"]
 
 _BITS = 10
@@ -164,6 +164,13 @@ def initial_search_state(x, search) -> SearchState:
     cand, over = search(x)
     z = jnp.asarray(0, jnp.int32)
     return SearchState(cand, z, x, z, z + 1, jnp.asarray(over, jnp.int32))
+
+
+@jax.jit
+def initial_state_of(load, x) -> SearchState:
+    """:func:`initial_search_state` of a contact load (a pytree with a ``search(x)`` method),
+    compiled: op by op, a grid search compiles each of its hundreds of operations on its own."""
+    return initial_search_state(x, load.search)
 
 
 def refreshed(state: SearchState, x, search, half_skin, every: int) -> SearchState:

@@ -481,7 +481,7 @@ class PlyLoad:
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
-        return broadphase.initial_search_state(jnp.asarray(x), self.search)
+        return broadphase.initial_state_of(self, jnp.asarray(x))
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)

@@ -15,6 +15,7 @@ from jaxform.self_contact import SelfContactLoad, edge_contact, self_contact_loa
 from test_intersections import folded_strip
 
 H = 4e-4
+_ply_contact = jax.jit(contact.ply_contact)  # op by op, each operation would compile on its own
 
 
 def _wavy_ply(n, size, z0, amp, phase):
@@ -87,7 +88,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(f[upper & flat_part, 2] > 0) and np.all(f[lower & flat_part, 2] < 0)  # apart
     np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-4 * np.abs(f).max())  # float32 sums
     # node to face: both passes (each with half the area) add up to one contact, k (0.1 h) A
-    fn = np.asarray(contact.ply_contact(x, jnp.asarray(v, jnp.float32), load.slave, load.triangles, st.candidates[0],
+    fn = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load.slave, load.triangles, st.candidates[0],
                                         load.gap0, load.area, load.params).force)
     np.testing.assert_allclose(np.median(fn[upper & flat_part, 2]), 1e10 * 0.1 * H * 1e-6, rtol=1e-3)
     # edge to edge: flat layers 0.9 h apart are 0.9 h apart edge to edge as well (another k (0.1 h)
@@ -116,7 +117,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     st_r = load_r.initial_state(x)
     assert np.all(np.asarray(st_r.candidates[0])[upper & flat_part, 0] < 0)  # the nearest: the other layer
     f_r = np.asarray(jax.jit(load_r.force)(x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
-    fn_r = np.asarray(contact.ply_contact(x, jnp.asarray(v, jnp.float32), load_r.slave, load_r.triangles,
+    fn_r = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load_r.slave, load_r.triangles,
                                           st_r.candidates[0], load_r.gap0, load_r.area, load_r.params).force)
     np.testing.assert_allclose(fn_r, fn, atol=1e-5 * np.abs(fn).max())
     # edge pairs: flat layers are equally near many edges of the other, which one is taken depends
@@ -126,11 +127,11 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     nodes2, x02, t2 = _fold(1.1 * H)
     load2 = _load(x02, t2)
     x2 = jnp.asarray(nodes2, jnp.float32)
-    f2, _, _ = load2.force(x2, jnp.zeros_like(x2), 0.0, load2.initial_state(x2))
+    f2, _, _ = jax.jit(load2.force)(x2, jnp.zeros_like(x2), 0.0, load2.initial_state(x2))
     assert float(jnp.abs(f2).max()) == 0.0
     cand = st.candidates[0]
-    g = jax.grad(lambda xx: contact.ply_contact(xx, jnp.zeros_like(xx), load.slave, load.triangles, cand, load.gap0,
-                                                load.area, load.params).energy)(x)
+    g = jax.jit(jax.grad(lambda xx: contact.ply_contact(xx, jnp.zeros_like(xx), load.slave, load.triangles, cand,
+                                                        load.gap0, load.area, load.params).energy))(x)
     assert np.all(np.isfinite(np.asarray(g))) and float(jnp.abs(g).max()) > 0
 
 
@@ -169,10 +170,10 @@ def test_crossing_ridges_are_held_apart_edge_to_edge_by_the_energy_gradient():
     load = _load(x0, t)
     x = jnp.asarray(nodes)
     st = load.initial_state(x)
-    fn = contact.ply_contact(x, jnp.zeros_like(x), load.slave, load.triangles, st.candidates[0], load.gap0,
+    fn = _ply_contact(x, jnp.zeros_like(x), load.slave, load.triangles, st.candidates[0], load.gap0,
                              load.area, load.params)
     assert float(jnp.min(fn.gap)) > 0.4 * H and float(jnp.abs(fn.force).max()) == 0.0  # nodes see nothing
-    f, _, ex = load.force(x, jnp.zeros_like(x), 0.0, st)
+    f, _, ex = jax.jit(load.force)(x, jnp.zeros_like(x), 0.0, st)
     f = np.asarray(f)
     np.testing.assert_allclose(float(ex["min_edge_gap"]), -0.2 * H, rtol=1e-6)
     assert f[25:, 2].sum() > 0 and f[:25, 2].sum() < 0  # the upper ridge up, the lower one down
@@ -186,7 +187,7 @@ def test_crossing_ridges_are_held_apart_edge_to_edge_by_the_energy_gradient():
     # 1.1 h apart: no force
     nodes2, _, _ = _ridges(1.1 * H)
     x2 = jnp.asarray(nodes2)
-    assert float(jnp.abs(load.force(x2, jnp.zeros_like(x2), 0.0, load.initial_state(x2))[0]).max()) == 0.0
+    assert float(jnp.abs(jax.jit(load.force)(x2, jnp.zeros_like(x2), 0.0, load.initial_state(x2))[0]).max()) == 0.0
 
 
 def test_bending_and_a_flat_sheet_are_not_contact():
@@ -204,7 +205,7 @@ def test_bending_and_a_flat_sheet_are_not_contact():
     for x, ref in ((nodes, x0), (x0, x0)):
         load = _load(ref, t)
         xj = jnp.asarray(x, jnp.float32)
-        f, _, ex = load.force(xj, jnp.zeros_like(xj), 0.0, load.initial_state(xj))
+        f, _, ex = jax.jit(load.force)(xj, jnp.zeros_like(xj), 0.0, load.initial_state(xj))
         assert float(jnp.abs(f).max()) == 0.0 and float(ex["min_gap"]) > 0 and float(ex["min_edge_gap"]) > 0
 
 
@@ -291,7 +292,7 @@ def test_a_strip_squeezed_between_plates_folds_into_layers_that_do_not_cross():
     x, mesh, h, sc = _squeeze_strip(True)
     xj = jnp.asarray(x)
     (cand, ecand, *_), _ = sc.search(xj)
-    gap = np.asarray(contact.ply_contact(xj, jnp.zeros_like(xj), sc.slave, sc.triangles, cand, sc.gap0, sc.area,
+    gap = np.asarray(_ply_contact(xj, jnp.zeros_like(xj), sc.slave, sc.triangles, cand, sc.gap0, sc.area,
                                          sc.params).gap)
     gap_e = np.asarray(edge_contact(xj, jnp.zeros_like(xj), sc.edges, ecand, sc.gap0, sc.edge_area, sc.params).gap)
     gap = np.minimum(gap.min(), gap_e.min())  # the distance of the layers: vertex-face or edge-edge

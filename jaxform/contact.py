@@ -483,6 +483,12 @@ class PlyLoad:
         """The load state for the initial positions ``x`` (N, 3)."""
         return broadphase.initial_state_of(self, jnp.asarray(x))
 
+    def node_pressure(self, x, v, load_state):
+        """``(slave (S,) int, pressure (S,) Pa)``: the contact pressure of the slave nodes at the
+        state's candidates (the nodal contact-pressure field of a frame)."""
+        res = ply_contact(x, v, self.slave, self.triangles, load_state.candidates, self.gap0, self.area, self.params)
+        return self.slave, res.pressure
+
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
         res = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, self.params)

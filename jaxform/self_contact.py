@@ -238,6 +238,13 @@ class SelfContactLoad:
         """The load state for the initial positions ``x`` (N, 3)."""
         return broadphase.initial_state_of(self, jnp.asarray(x))
 
+    def node_pressure(self, x, v, load_state):
+        """``(slave (N,) int, pressure (N,) Pa)``: the node-to-face contact pressure at the state's
+        candidates (the nodal contact-pressure field of a frame; edge pairs carry no nodal pressure)."""
+        res = ply_contact(x, v, self.slave, self.triangles, load_state.candidates.nodes, self.gap0, self.area,
+                          self.params)
+        return self.slave, res.pressure
+
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self.skin, self.refresh_every)
         c = st.candidates

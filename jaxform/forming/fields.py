@@ -91,9 +91,8 @@ def state_fields(model, state, ply_id, n_plies: int):
         phis.append(res.gap + load.offset)
         tool[i] = (res, dz)
     for load, ls in zip(model.loads[3:], state.loads[3:]):
-        cand = getattr(ls.candidates, "nodes", ls.candidates)  # self-contact: its node-to-face table
-        res = contact.ply_contact(x, state.v, load.slave, load.triangles, cand, load.gap0, load.area, load.params)
-        pressure = pressure.at[load.slave].add(res.pressure)
+        slave, p = load.node_pressure(x, state.v, ls)
+        pressure = pressure.at[slave].add(p)
     out["contact_pressure"] = pressure
     h = jnp.asarray(shell.fabrics[0].thickness, dtype)
     i = jnp.asarray(ply_id, dtype)

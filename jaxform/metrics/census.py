@@ -288,8 +288,11 @@ def wrinkle_census(x, deviation, *, faces=None, r_inner: float, r_outer: float |
             a = parent[a]
         return a
 
+    # crests come ring by ring (ring ascending): those of the next max_gap + 1 rings are a slice
+    stop = np.searchsorted(ring, ring + max_gap + 1, side="right")
+    first = np.searchsorted(ring, ring, side="right")
     for a in range(len(crests)):
-        later = np.flatnonzero((ring > ring[a]) & (ring <= ring[a] + max_gap + 1))
+        later = np.arange(first[a], stop[a])
         if not len(later):
             continue
         d = np.abs((ang[later] - ang[a] + np.pi) % (2 * np.pi) - np.pi) * np.minimum(r[ring[later]], r[ring[a]])

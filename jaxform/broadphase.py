@@ -9,16 +9,19 @@ that a thin sheet in a large box costs nothing for its empty cells):
    centroid-to-corner distance, ``reach`` the search distance): a triangle within ``reach`` of a
    point has its centroid in the point's cell or one of the 26 around it;
 2. sort the cell keys (``(i << 20) | (j << 10) | k``, 1024 cells a side, indices clipped);
-3. per point, look up the 27 cells by binary search and read at most ``cap`` triangles from each
-   (fixed shape ``(27 cap,)``; a fuller cell is counted in ``overflow``, never silently enlarged);
+3. per point, look up the 27 cells by binary search and read them in pages of ``cap`` triangles
+   per cell (fixed shape ``(27 cap,)``), as many pages as the fullest cell needs: every triangle
+   of the 27 cells is looked at, however crowded a fold makes a cell, while a small ``cap`` keeps
+   the usual sparse cell cheap;
 4. drop the pairs ``mask(point, triangle)`` refuses (a node's own neighbourhood in self-contact),
    keep the ``K`` nearest centroids; a slot left empty gets the point's ``fallback`` triangle.
 
-Cost per refresh: a sort of the F keys and ``27 * cap`` distance tests per point, i.e. ``O(N +
-F log F)`` against ``O(N F)`` for :func:`jaxform.geometry.nearest_centroids`. The candidates stay
-valid while no point has moved by more than half the skin (``reach`` minus the contact distance)
-since the refresh (:func:`moved_beyond`, the Verlet-list criterion: it ties the refresh to the
-largest node speed).
+Cost per refresh: a sort of the F keys and ``27 * cap * pages`` distance tests per point, i.e.
+``O(N + F log F)`` against ``O(N F)`` for :func:`jaxform.geometry.nearest_centroids`. The
+candidates stay valid while no point has moved by more than half the skin (``reach`` minus the
+contact distance) since the refresh (:func:`moved_beyond`, the Verlet-list criterion: it ties the
+refresh to the largest node speed). The search is integer bookkeeping: no gradient flows through
+it (its inputs are ``stop_gradient``-ed, so the page loop may have a traced trip count).
 """
 from __future__ import annotations
 
@@ -28,8 +31,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["cell_size", "grid_keys", "neighbour_slots", "candidates", "moved_beyond", "SearchState", "initial_search_state", "initial_state_of",
-           "refreshed"]
+__all__ = ["cell_size", "grid_keys", "cell_ranges", "candidates", "moved_beyond", "SearchState", "initial_search_state",
+           "initial_state_of", "refreshed"]
 
 _BITS = 10
 _SIDE = 1 << _BITS  # cells per axis
@@ -59,23 +62,18 @@ def grid_keys(centroids, lo, cell):
     return keys[order], order
 
 
-def neighbour_slots(points, sorted_keys, order, lo, cell, cap: int):
-    """``(ids (B, 27 cap) int32, valid (B, 27 cap) bool, overflow (B,) int32)``: the triangles
-    binned in the 27 cells around each point (B, 3), at most ``cap`` per cell, and the number of
-    those cells holding more than ``cap``."""
+def cell_ranges(points, sorted_keys, lo, cell):
+    """``(start (B, 27), end (B, 27))``: the slices of the sorted triangle list binned in the 27
+    cells around each point (B, 3) (empty where a cell lies outside the grid)."""
     ijk = _ijk(points, lo, cell)[:, None, :] + _OFFSETS[None]  # (B, 27, 3)
     inside = jnp.all((ijk >= 0) & (ijk < _SIDE), axis=-1)
     keys = jnp.where(inside, _key(ijk), -1)
-    start = jnp.searchsorted(sorted_keys, keys, side="left")
-    end = jnp.where(inside, jnp.searchsorted(sorted_keys, keys, side="right"), start)
-    slot = start[..., None] + jnp.arange(cap, dtype=start.dtype)  # (B, 27, cap)
-    valid = slot < end[..., None]
-    ids = order[jnp.clip(slot, 0, order.shape[0] - 1)]
-    b = points.shape[0]
-    return ids.reshape(b, -1), valid.reshape(b, -1), jnp.sum(end - start > cap, axis=1).astype(jnp.int32)
+    start = jnp.searchsorted(sorted_keys, keys, side="left").astype(jnp.int32)
+    end = jnp.where(inside, jnp.searchsorted(sorted_keys, keys, side="right").astype(jnp.int32), start)
+    return start, end
 
 
-def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback=None, cap: int = 16,
+def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback=None, cap: int = 8,
                chunk: int = 2048):
     """The ``k`` triangles with the nearest centroids within reach of each point.
 
@@ -84,55 +82,62 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback
         tri_x: (F, 3, 3) triangle corners, m.
         k: candidates per point (static).
         reach: () search distance, m (contact distance plus skin): every triangle with a point
-            closer than ``reach`` is among those looked at (while no cell overflows).
+            closer than ``reach`` is among those looked at.
         mask: optional ``mask(point_ids (B,), tri_ids (B, M)) -> (B, M) bool``, the pairs allowed.
         refine: optional costlier test of the same form, applied only to the ``2 k`` nearest pairs
             ``mask`` allows (a short list), before the ``k`` nearest are kept.
         fallback: optional (N,) int triangle of each point for the empty slots (default 0); it
             must be a pair ``mask`` allows, and is then beyond ``reach`` whenever a slot is empty.
-        cap: triangles read per cell (static); chunk: points per block (static).
+        cap: triangles read per cell and page (static; the fullest cell sets the number of pages);
+        chunk: points per block (static).
 
     Returns:
-        ``(ids (N, k) int32, found (N, k) bool, overflow () int32)``: nearest first; empty slots
-        hold the point's best candidate, or its ``fallback`` when it has none; ``overflow`` counts
-        (point, cell) lookups that met a cell with more than ``cap`` triangles.
+        ``(ids (N, k) int32, found (N, k) bool)``: nearest first; empty slots hold the point's
+        best candidate, or its ``fallback`` when it has none.
     """
-    points = jnp.asarray(points)
-    tri_x = jnp.asarray(tri_x)
+    points = jax.lax.stop_gradient(jnp.asarray(points))
+    tri_x = jax.lax.stop_gradient(jnp.asarray(tri_x))
     n = points.shape[0]
     cen = jnp.mean(tri_x, axis=1)
     cell = cell_size(tri_x, reach)
     lo = jnp.minimum(jnp.min(cen, axis=0), jnp.min(points, axis=0)) - cell
     sorted_keys, order = grid_keys(cen, lo, cell)
+    fullest = jnp.max(jnp.searchsorted(sorted_keys, sorted_keys, side="right")
+                      - jnp.searchsorted(sorted_keys, sorted_keys, side="left"))
+    pages = (fullest + cap - 1) // cap
     fb = jnp.zeros((n,), jnp.int32) if fallback is None else jnp.asarray(fallback, jnp.int32)
     chunk = int(max(1, min(chunk, n)))
     pad = (-n) % chunk
     pid = jnp.concatenate([jnp.arange(n, dtype=jnp.int32), jnp.zeros((pad,), jnp.int32)]).reshape(-1, chunk)
-    k_eff = int(min(k, 27 * cap))
+    keep = 2 * k if refine is not None else k
+    lane = jnp.arange(cap, dtype=jnp.int32)
 
     def block(ids_p):
         p = points[ids_p]
-        ids, valid, over = neighbour_slots(p, sorted_keys, order, lo, cell, cap)
-        if mask is not None:
-            valid = valid & mask(ids_p, ids)
-        d2 = jnp.sum((p[:, None, :] - cen[ids]) ** 2, axis=-1)
-        d2 = jnp.where(valid, d2, jnp.inf)
+        start, end = cell_ranges(p, sorted_keys, lo, cell)
+
+        def page(q, best):  # merge the page-q triangles of the 27 cells into the ``keep`` nearest
+            slot = start[..., None] + q * cap + lane  # (B, 27, cap)
+            ids = order[jnp.clip(slot, 0, order.shape[0] - 1)].reshape(chunk, -1)
+            valid = (slot < end[..., None]).reshape(chunk, -1)
+            if mask is not None:
+                valid = valid & mask(ids_p, ids)
+            d2 = jnp.where(valid, jnp.sum((p[:, None, :] - cen[ids]) ** 2, axis=-1), jnp.inf)
+            neg, j = jax.lax.top_k(-jnp.concatenate([best[0], d2], axis=1), keep)
+            return -neg, jnp.take_along_axis(jnp.concatenate([best[1], ids], axis=1), j, axis=1)
+
+        d2, ids = jax.lax.fori_loop(0, pages, page, (jnp.full((chunk, keep), jnp.inf, points.dtype),
+                                                     jnp.zeros((chunk, keep), jnp.int32)))
         if refine is not None:
-            neg, j = jax.lax.top_k(-d2, min(2 * k_eff, d2.shape[1]))
-            ids = jnp.take_along_axis(ids, j, axis=1)
-            d2 = jnp.where(refine(ids_p, ids), -neg, jnp.inf)
-        neg, j = jax.lax.top_k(-d2, k_eff)
+            d2 = jnp.where(refine(ids_p, ids), d2, jnp.inf)
+        neg, j = jax.lax.top_k(-d2, k)
         best = jnp.take_along_axis(ids, j, axis=1)
         found = jnp.isfinite(neg)
         first = jnp.where(found[:, :1], best[:, :1], fb[ids_p][:, None])
-        return jnp.where(found, best, first), found, over
+        return jnp.where(found, best, first), found
 
-    ids, found, over = jax.lax.map(block, pid)
-    ids, found = ids.reshape(-1, k_eff)[:n], found.reshape(-1, k_eff)[:n]
-    if k_eff < k:  # more slots than the cells can fill: repeat the first
-        ids = jnp.concatenate([ids, jnp.broadcast_to(ids[:, :1], (n, k - k_eff))], axis=1)
-        found = jnp.concatenate([found, jnp.zeros((n, k - k_eff), bool)], axis=1)
-    return ids.astype(jnp.int32), found, jnp.sum(over.reshape(-1)[:n])
+    ids, found = jax.lax.map(block, pid)
+    return ids.reshape(-1, k)[:n].astype(jnp.int32), found.reshape(-1, k)[:n]
 
 
 def moved_beyond(x, x_ref, distance):
@@ -147,8 +152,7 @@ class SearchState(NamedTuple):
     Attributes:
         candidates: (N_s, K) int32 triangle ids (``~id`` where the node was on the back side).
         step: () int32 calls so far; x_ref: (N, 3) positions at the last refresh, m;
-        last: () int32 call of the last refresh; refreshes: () int32 refreshes so far;
-        overflow: () int32 overflowing cell lookups at the last refresh (0 when complete).
+        last: () int32 call of the last refresh; refreshes: () int32 refreshes so far.
     """
 
     candidates: Any
@@ -156,14 +160,12 @@ class SearchState(NamedTuple):
     x_ref: Any
     last: Any
     refreshes: Any
-    overflow: Any
 
 
 def initial_search_state(x, search) -> SearchState:
-    """The :class:`SearchState` for positions ``x`` (N, 3); ``search(x) -> (candidates, overflow)``."""
-    cand, over = search(x)
+    """The :class:`SearchState` for positions ``x`` (N, 3); ``search(x) -> candidates``."""
     z = jnp.asarray(0, jnp.int32)
-    return SearchState(cand, z, x, z, z + 1, jnp.asarray(over, jnp.int32))
+    return SearchState(search(x), z, x, z, z + 1)
 
 
 @jax.jit
@@ -179,8 +181,7 @@ def refreshed(state: SearchState, x, search, half_skin, every: int) -> SearchSta
     due = moved_beyond(x, state.x_ref, half_skin) | (state.step - state.last >= every)
 
     def fresh():
-        cand, over = search(x)
-        return SearchState(cand, state.step, x, state.step, state.refreshes + 1, jnp.asarray(over, jnp.int32))
+        return SearchState(search(x), state.step, x, state.step, state.refreshes + 1)
 
     new = jax.lax.cond(due, fresh, lambda: state)
     return new._replace(step=state.step + 1)

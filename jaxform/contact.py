@@ -457,7 +457,7 @@ class PlyLoad:
     Attributes:
         slave: (N_s,) int; triangles: (F, 3) int; gap0: () m; area: () or (N_s,) m²;
         params: :class:`ContactParams`; skin: () m (default ``gap0``);
-        k, refresh_every, cap (triangles read per grid cell): static ints.
+        k, refresh_every, cap (triangles read per grid cell and page): static ints.
     """
 
     slave: Any
@@ -468,16 +468,14 @@ class PlyLoad:
     skin: Any = None
     k: int = static_field(default=8)
     refresh_every: int = static_field(default=200)
-    cap: int = static_field(default=16)
+    cap: int = static_field(default=8)
 
     def _skin(self):
         return self.gap0 if self.skin is None else self.skin
 
     def search(self, x):
-        """``(candidates (N_s, k) int32, overflow ())`` for positions ``x`` (N, 3)."""
-        ids, _, over = broadphase.candidates(x[self.slave], x[self.triangles], self.k, self.gap0 + self._skin(),
-                                             cap=self.cap)
-        return ids, over
+        """``candidates (N_s, k) int32`` for positions ``x`` (N, 3)."""
+        return broadphase.candidates(x[self.slave], x[self.triangles], self.k, self.gap0 + self._skin(), cap=self.cap)[0]
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
@@ -493,7 +491,7 @@ class PlyLoad:
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
         res = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, self.params)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
-                  "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes, "search_overflow": st.overflow}
+                  "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes}
         return res.force, st, extras
 
 

@@ -174,7 +174,7 @@ class SelfContactLoad:
     active_cap: int = static_field(default=1024)
     edge_active_cap: int = static_field(default=3072)
     refresh_every: int = static_field(default=200)
-    cap: int = static_field(default=32)
+    cap: int = static_field(default=8)
 
     def plausible(self, nodes, tris):
         """(B, M) bool, cheap: the plies may touch and the reference centroid is not closer than
@@ -220,9 +220,9 @@ class SelfContactLoad:
         return jnp.where(jnp.isfinite(neg), best, self.edge_fallback[:, None]).astype(jnp.int32), -neg[:, 0]
 
     def search(self, x):
-        """``(Candidates, overflow ())`` for positions ``x`` (N, 3)."""
+        """:class:`Candidates` for positions ``x`` (N, 3)."""
         tri_x = x[self.triangles]
-        ids, _, over = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
+        ids, _ = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
                                              refine=self.allowed, fallback=self.fallback, cap=self.cap)
         eids, e_d2 = self.edge_candidates(x, ids)
         t = tri_x[ids]  # (N, k, 3, 3)
@@ -232,7 +232,7 @@ class SelfContactLoad:
         reach2 = (self.gap0 + self.skin) ** 2
         act_n, full_n = _compact(jnp.min(jnp.sum((x[:, None, :] - q) ** 2, axis=-1), axis=1) <= reach2, self.active_cap)
         act_e, full_e = _compact(e_d2 <= reach2, self.edge_active_cap)
-        return Candidates(jnp.where(front, ids, ~ids).astype(jnp.int32), eids, act_n, act_e, full_n | full_e), over
+        return Candidates(jnp.where(front, ids, ~ids).astype(jnp.int32), eids, act_n, act_e, full_n | full_e)
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""
@@ -264,12 +264,12 @@ class SelfContactLoad:
 
         f, extras = jax.lax.cond(c.overflow, lambda: part(self.slave, jnp.arange(self.edges.shape[0])),
                                  lambda: part(c.active_nodes, c.active_edges))
-        extras.update(refreshes=st.refreshes, search_overflow=st.overflow, active_overflow=c.overflow.astype(jnp.int32))
+        extras.update(refreshes=st.refreshes, active_overflow=c.overflow.astype(jnp.int32))
         return f, st, extras
 
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
-                      skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 32,
+                      skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 8,
                       active_fraction: float = 0.125, dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
 

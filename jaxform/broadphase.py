@@ -10,8 +10,8 @@ that a thin sheet in a large box costs nothing for its empty cells):
    point has its centroid in the point's cell or one of the 26 around it;
 2. sort the cell keys (``(i << 20) | (j << 10) | k``, 1024 cells a side, indices clipped);
 3. per point, look up the 27 cells by binary search and read them in pages of ``cap`` triangles
-   per cell (fixed shape ``(27 cap,)``), as many pages as the fullest cell needs: every triangle
-   of the 27 cells is looked at, however crowded a fold makes a cell, while a small ``cap`` keeps
+   per cell (fixed shape ``(27 cap,)``), as many pages as the fullest of them needs (per block
+   of points): every triangle of the 27 cells is looked at, however crowded a fold makes a cell, while a small ``cap`` keeps
    the usual sparse cell cheap;
 4. drop the pairs ``mask(point, triangle)`` refuses (a node's own neighbourhood in self-contact),
    keep the ``K`` nearest centroids; a slot left empty gets the point's ``fallback`` triangle.
@@ -74,7 +74,7 @@ def cell_ranges(points, sorted_keys, lo, cell):
 
 
 def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback=None, cap: int = 8,
-               chunk: int = 2048):
+               chunk: int = 512):
     """The ``k`` triangles with the nearest centroids within reach of each point.
 
     Args:
@@ -88,8 +88,8 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback
             ``mask`` allows (a short list), before the ``k`` nearest are kept.
         fallback: optional (N,) int triangle of each point for the empty slots (default 0); it
             must be a pair ``mask`` allows, and is then beyond ``reach`` whenever a slot is empty.
-        cap: triangles read per cell and page (static; the fullest cell sets the number of pages);
-        chunk: points per block (static).
+        cap: triangles read per cell and page (static; the fullest cell a block of points looks
+            at sets that block's number of pages); chunk: points per block (static).
 
     Returns:
         ``(ids (N, k) int32, found (N, k) bool)``: nearest first; empty slots hold the point's
@@ -102,9 +102,6 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback
     cell = cell_size(tri_x, reach)
     lo = jnp.minimum(jnp.min(cen, axis=0), jnp.min(points, axis=0)) - cell
     sorted_keys, order = grid_keys(cen, lo, cell)
-    fullest = jnp.max(jnp.searchsorted(sorted_keys, sorted_keys, side="right")
-                      - jnp.searchsorted(sorted_keys, sorted_keys, side="left"))
-    pages = (fullest + cap - 1) // cap
     fb = jnp.zeros((n,), jnp.int32) if fallback is None else jnp.asarray(fallback, jnp.int32)
     chunk = int(max(1, min(chunk, n)))
     pad = (-n) % chunk
@@ -115,6 +112,7 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback
     def block(ids_p):
         p = points[ids_p]
         start, end = cell_ranges(p, sorted_keys, lo, cell)
+        pages = (jnp.max(end - start) + cap - 1) // cap  # the fullest cell this block looks at
 
         def page(q, best):  # merge the page-q triangles of the 27 cells into the ``keep`` nearest
             slot = start[..., None] + q * cap + lane  # (B, 27, cap)

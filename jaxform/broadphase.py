@@ -11,8 +11,8 @@ that a thin sheet in a large box costs nothing for its empty cells):
 2. sort the cell keys (``(i << 20) | (j << 10) | k``, 1024 cells a side, indices clipped);
 3. per point, look up the 27 cells by binary search and read them in pages of ``cap`` triangles
    per cell (fixed shape ``(27 cap,)``), as many pages as the fullest of them needs (per block
-   of points): every triangle of the 27 cells is looked at, however crowded a fold makes a cell, while a small ``cap`` keeps
-   the usual sparse cell cheap;
+   of points): every triangle of the 27 cells is looked at, however crowded a fold makes a
+   cell, while a small ``cap`` keeps the usual sparse cell cheap;
 4. drop the pairs ``mask(point, triangle)`` refuses (a node's own neighbourhood in self-contact),
    keep the ``K`` nearest centroids; a slot left empty gets the point's ``fallback`` triangle.
 

@@ -223,7 +223,7 @@ class SelfContactLoad:
         """:class:`Candidates` for positions ``x`` (N, 3)."""
         tri_x = x[self.triangles]
         ids, _ = broadphase.candidates(x, tri_x, self.k, self.gap0 + self.skin, mask=self.plausible,
-                                             refine=self.allowed, fallback=self.fallback, cap=self.cap)
+                                       refine=self.allowed, fallback=self.fallback, cap=self.cap)
         eids, e_d2 = self.edge_candidates(x, ids)
         t = tri_x[ids]  # (N, k, 3, 3)
         q, _ = closest_point_triangle(x[:, None, :], t[..., 0, :], t[..., 1, :], t[..., 2, :])

@@ -475,7 +475,8 @@ class PlyLoad:
 
     def search(self, x):
         """``candidates (N_s, k) int32`` for positions ``x`` (N, 3)."""
-        return broadphase.candidates(x[self.slave], x[self.triangles], self.k, self.gap0 + self._skin(), cap=self.cap)[0]
+        reach = self.gap0 + self._skin()
+        return broadphase.candidates(x[self.slave], x[self.triangles], self.k, reach, cap=self.cap)[0]
 
     def initial_state(self, x):
         """The load state for the initial positions ``x`` (N, 3)."""

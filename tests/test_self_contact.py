@@ -16,6 +16,8 @@ from test_intersections import folded_strip
 
 H = 4e-4
 _ply_contact = jax.jit(contact.ply_contact)  # op by op, each operation would compile on its own
+# the load as an argument: loads of one shape and room share one compiled program
+_force = jax.jit(lambda load, x, v, t, st: load.force(x, v, t, st))
 
 
 def _wavy_ply(n, size, z0, amp, phase):
@@ -83,7 +85,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     st = load.initial_state(x)
     v = np.zeros_like(nodes)
     v[nodes[:, 2] > 0.5 * H, 1] = 0.01  # upper layer sliding across
-    f, st2, ex = jax.jit(load.force)(x, jnp.asarray(v, jnp.float32), 0.0, st)
+    f, st2, ex = _force(load, x, jnp.asarray(v, jnp.float32), 0.0, st)
     f = np.asarray(f)
     upper, lower = nodes[:, 2] > 0.5 * H, (nodes[:, 2] < 0.5 * H) & (nodes[:, 0] < 0.019)
     flat_part = (nodes[:, 0] > 0.001) & (nodes[:, 0] < 0.017)
@@ -107,7 +109,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     small = _load(x0, t, active_fraction=0.0)  # room for 64: overflows, all evaluated
     st_s = small.initial_state(x)
     assert bool(st_s.candidates.overflow) and not bool(st.candidates.overflow)
-    f_s, _, ex_s = jax.jit(small.force)(x, jnp.asarray(v, jnp.float32), 0.0, st_s)
+    f_s, _, ex_s = _force(small, x, jnp.asarray(v, jnp.float32), 0.0, st_s)
     np.testing.assert_allclose(np.asarray(f_s), f, atol=1e-6 * np.abs(f).max())
     assert int(ex_s["active_overflow"]) == 1 and int(ex["active_overflow"]) == 0
     assert np.all(fe[upper & flat_part, 2] > 0) and np.abs(fe[upper & flat_part, 1]).max() < 1e-3 * fe[upper, 2].max()
@@ -115,10 +117,10 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(f[upper & flat_part, 1] < 0)  # friction against the slip
     assert int(st2.step) == 1
     # two-sided: every triangle turned over, the layers are seen from their backs, same forces
-    load_r = _load(x0, t[:, ::-1].copy())
+    load_r = _load(x0, t[:, ::-1].copy(), active_fraction=1.0)  # the program of `load`
     st_r = load_r.initial_state(x)
     assert np.all(np.asarray(st_r.candidates[0])[upper & flat_part, 0] < 0)  # the nearest: the other layer
-    f_r = np.asarray(jax.jit(load_r.force)(x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
+    f_r = np.asarray(_force(load_r, x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
     fn_r = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load_r.slave, load_r.triangles,
                                           st_r.candidates[0], load_r.gap0, load_r.area, load_r.params).force)
     np.testing.assert_allclose(fn_r, fn, atol=1e-5 * np.abs(fn).max())
@@ -127,9 +129,9 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     np.testing.assert_allclose(f_r[upper].sum(axis=0), f[upper].sum(axis=0), rtol=1e-4, atol=1e-4 * np.abs(f).max())
     # layers h apart (and more): no force; gradient of the penalty energy finite
     nodes2, x02, t2 = _fold(1.1 * H)
-    load2 = _load(x02, t2)
+    load2 = _load(x02, t2, active_fraction=1.0)
     x2 = jnp.asarray(nodes2, jnp.float32)
-    f2, _, _ = jax.jit(load2.force)(x2, jnp.zeros_like(x2), 0.0, load2.initial_state(x2))
+    f2, _, _ = _force(load2, x2, jnp.zeros_like(x2), 0.0, load2.initial_state(x2))
     assert float(jnp.abs(f2).max()) == 0.0
     cand = st.candidates[0]
     g = jax.jit(jax.grad(lambda xx: contact.ply_contact(xx, jnp.zeros_like(xx), load.slave, load.triangles, cand,
@@ -175,7 +177,7 @@ def test_crossing_ridges_are_held_apart_edge_to_edge_by_the_energy_gradient():
     fn = _ply_contact(x, jnp.zeros_like(x), load.slave, load.triangles, st.candidates[0], load.gap0,
                              load.area, load.params)
     assert float(jnp.min(fn.gap)) > 0.4 * H and float(jnp.abs(fn.force).max()) == 0.0  # nodes see nothing
-    f, _, ex = jax.jit(load.force)(x, jnp.zeros_like(x), 0.0, st)
+    f, _, ex = _force(load, x, jnp.zeros_like(x), 0.0, st)
     f = np.asarray(f)
     np.testing.assert_allclose(float(ex["min_edge_gap"]), -0.2 * H, rtol=1e-6)
     assert f[25:, 2].sum() > 0 and f[:25, 2].sum() < 0  # the upper ridge up, the lower one down
@@ -185,11 +187,11 @@ def test_crossing_ridges_are_held_apart_edge_to_edge_by_the_energy_gradient():
     ec = st.candidates[1]
     energy = lambda y: edge_contact(y, jnp.zeros_like(y), load.edges, ec, load.gap0, load.edge_area,  # noqa: E731
                                     load.params).energy
-    np.testing.assert_allclose(f, -np.asarray(jax.grad(energy)(x)), rtol=1e-9, atol=1e-12 * np.abs(f).max())
+    np.testing.assert_allclose(f, -np.asarray(jax.jit(jax.grad(energy))(x)), rtol=1e-9, atol=1e-12 * np.abs(f).max())
     # 1.1 h apart: no force
     nodes2, _, _ = _ridges(1.1 * H)
     x2 = jnp.asarray(nodes2)
-    assert float(jnp.abs(jax.jit(load.force)(x2, jnp.zeros_like(x2), 0.0, load.initial_state(x2))[0]).max()) == 0.0
+    assert float(jnp.abs(_force(load, x2, jnp.zeros_like(x2), 0.0, load.initial_state(x2))[0]).max()) == 0.0
 
 
 def test_bending_and_a_flat_sheet_are_not_contact():
@@ -207,7 +209,7 @@ def test_bending_and_a_flat_sheet_are_not_contact():
     for x, ref in ((nodes, x0), (x0, x0)):
         load = _load(ref, t)
         xj = jnp.asarray(x, jnp.float32)
-        f, _, ex = jax.jit(load.force)(xj, jnp.zeros_like(xj), 0.0, load.initial_state(xj))
+        f, _, ex = _force(load, xj, jnp.zeros_like(xj), 0.0, load.initial_state(xj))
         assert float(jnp.abs(f).max()) == 0.0 and float(ex["min_gap"]) > 0 and float(ex["min_edge_gap"]) > 0
 
 

@@ -1,7 +1,7 @@
 """Execute notebooks/05_calibration.ipynb: cantilever round trip (two overhangs, one fit) from the
 reference elastica and a picture-frame fit checked on the shell (STYLE habit 9).
 
-Part of the default suite: about 45 s on a quiet 2-core machine (one compile of the 20-element
+Part of the default suite: about 31 s alone on a quiet 2-core machine (one compile of the 20-element
 cantilever, which dominates; the picture frame about 10 s).
 """
 import re

@@ -264,13 +264,23 @@ def _design(loc, h):
 
 
 def _gfd_weights_patch(nodes, frames, patch):
-    """Vectorised weights for fixed-size patches (N, K) that include the node itself."""
+    """Vectorised weights for fixed-size 3x3 patches (N, 9) that include the node itself.
+
+    The fit carries the cubic terms ``X² Y`` and ``X Y²`` besides the quadratic ones, so that the
+    second derivatives are those *at the node*, also where the patch is shifted inwards (a free
+    edge or corner): with the quadratic fit alone an edge node read the along-edge curvature
+    averaged over its own row and the next two, and a curvature that grows towards the edge (a
+    wave along it) was under-read, by half at 4 cells across (see ``tests/test_buckling.py``).
+    On a centred patch the cubic columns are orthogonal to the quadratic ones, and the weights
+    are the row-averaged central differences as before.
+    """
     d = nodes[patch] - nodes[:, None, :]  # (N, K, 3)
     loc = np.einsum("nkc,nac->nka", d, frames[:, :2, :])  # (N, K, 2)
     h = np.sqrt(np.mean(np.sum(loc**2, -1), axis=1))  # patch scale
     X, Y = loc[..., 0] / h[:, None], loc[..., 1] / h[:, None]
-    A = np.stack([X, Y, 0.5 * X * X, X * Y, 0.5 * Y * Y], axis=2)  # (N, K, 5); self row is zero
-    P = np.linalg.pinv(A)  # (N, 5, K)
+    # (N, K, 7); the self row is zero
+    A = np.stack([X, Y, 0.5 * X * X, X * Y, 0.5 * Y * Y, 0.5 * X * X * Y, 0.5 * X * Y * Y], axis=2)
+    P = np.linalg.pinv(A)[:, :5]  # (N, 5, K): the derivatives up to second order
     pw = np.array([1, 1, 2, 2, 2])
     return patch.astype(np.int64), P / h[:, None, None] ** pw[None, :, None]
 

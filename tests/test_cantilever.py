@@ -10,9 +10,10 @@ the uniform mesh (``grading=1``):
     Voce    70 deg    -5.32%    -2.07%    -0.68%    -0.19%
 
 The default mesh is graded toward the clamp (``grading=20``); at n = 40 the same cases measure
-+0.069%, -0.004%, +0.064%, -0.025%. For a Voce strip bent far past ``kappa0`` (22 ``kappa0`` at
-the clamp) the whole profile matters, see ``test_voce_profile_far_past_kappa0_matches_elastica``
-and the table in ``jaxform/cantilever.py``.
++0.065%, -0.002%, +0.060%, -0.023% (+0.069%, -0.004%, +0.064%, -0.025% before the free-edge
+stencil of ``jaxform.mesh``). For a Voce strip bent far past ``kappa0`` (22 ``kappa0`` at the
+clamp) the whole profile matters, see ``test_voce_profile_far_past_kappa0_matches_elastica`` and
+the table in ``jaxform/cantilever.py``.
 
 The tests run at n = 40 (the default): one compile of the solver serves every test here.
 """

@@ -51,6 +51,35 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert sorted(p.name for p in tmp_out.glob("frames_*.vtu")) == ["frames_00000.vtu", "frames_00001.vtu"]
 
 
+def test_verify_quasi_static_runs_half_the_speed_and_records_the_check(tmp_out, capsys):
+    rc = main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--verify-quasi-static"])
+    text = capsys.readouterr().out
+    s = json.loads((tmp_out / "summary.json").read_text())
+    c = s["quasi_static_check"]
+    half = json.loads((tmp_out / "half_speed" / "summary.json").read_text())
+    assert s["complete"] and half["complete"]
+    assert c["speed_mm_per_s"] == pytest.approx(500.0) and c["half_speed_mm_per_s"] == pytest.approx(250.0)
+    assert half["inputs"]["process"]["speed_mm_per_s"] == pytest.approx(250.0)
+    assert (tmp_out / "half_speed" / "frames.pvd").is_file()
+    # the differences are those of the two runs' own summaries and fields
+    assert c["draw_in_edge_mid_m"] == [s["draw_in"]["edge_mid_m"], half["draw_in"]["edge_mid_m"]]
+    assert c["flange_wrinkles"] == [s["flange_wrinkles"], half["flange_wrinkles"]]
+    d0, d1 = c["draw_in_edge_mid_m"]
+    assert c["draw_in_edge_mid_rel"] == pytest.approx(abs(d0 - d1) / abs(d1))
+    g0 = meshio.read(tmp_out / _pvd_files(tmp_out)[-1][1]).point_data["shear_angle_deg"]
+    g1 = meshio.read(tmp_out / "half_speed" / _pvd_files(tmp_out / "half_speed")[-1][1]).point_data["shear_angle_deg"]
+    assert c["shear_p95_deg"] == pytest.approx(np.percentile(np.abs(g0 - g1), 95), rel=1e-4, abs=1e-6)
+    assert c["shear_p95_deg"] > 0  # the speed changed something
+    verdict = c["shear_p95_deg"] < 1.0 and c["draw_in_edge_mid_rel"] < 0.02 and c["flange_wrinkles_diff"] == 0
+    assert c["quasi_static"] is verdict
+    assert rc == (0 if verdict else 3)
+    assert "quasi-static check against half the speed (250 mm/s" in text
+    # a rerun without the check removes the half-speed folder it left: never read as this run's
+    assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 0
+    assert not (tmp_out / "half_speed").exists()
+    assert "quasi_static_check" not in json.loads((tmp_out / "summary.json").read_text())
+
+
 def test_a_run_normalises_its_case_and_builds_its_rig_once(tmp_out, monkeypatch):
     from jaxform import cases
     from jaxform.forming import rig

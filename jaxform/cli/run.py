@@ -27,6 +27,10 @@ QUASI_STATIC_KE_IE = 0.1
 """A run whose kinetic energy exceeds this fraction of the internal energy is flagged as not quasi-static."""
 OUTPUTS = ("frames_*.vtu", "frames.pvd", "summary.json", "shear_angle.png", "deviation.png", "punch_force.png")
 """What a run writes into its folder (a rerun replaces all of it)."""
+HALF_SPEED = "half_speed"
+"""The sub-folder of ``--verify-quasi-static``'s half-speed run (a run folder of its own)."""
+NOT_QUASI_STATIC = 3
+"""Exit status of a complete run that ``--verify-quasi-static`` finds not quasi-static (or cannot check)."""
 
 
 def add_parser(subparsers) -> None:
@@ -42,6 +46,10 @@ def add_parser(subparsers) -> None:
                    help="override a case key, e.g. --set process.speed_mm_per_s=250 (repeatable)")
     p.add_argument("--force", action="store_true", help="write into a non-empty directory")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--verify-quasi-static", action="store_true",
+                   help=f"also run the case at half the punch speed (into OUT/{HALF_SPEED}) and report the differences "
+                        "(shear-angle map, edge draw-in, flange wrinkles) in summary.json under 'quasi_static_check'; "
+                        f"exit status {NOT_QUASI_STATIC} when they exceed the limits")
     p.set_defaults(handler=run)
 
 
@@ -120,6 +128,58 @@ def _plots(result, out):
     return paths
 
 
+def verify_quasi_static(result, out, *, force=False, quiet=False, stream=None) -> dict:
+    """Run ``result``'s case again at half its punch speed into ``out/half_speed`` and record the
+    comparison (:func:`jaxform.forming.quasi_static_check`) in ``out/summary.json`` under
+    ``quasi_static_check``; returns it. An incomplete run is not checked (the record says so)."""
+    from jaxform import cases, forming
+    from jaxform.io.frames import write_json
+
+    out = pathlib.Path(out)
+    if not result.complete:
+        check = {"quasi_static": False, "reason": f"the run is incomplete ({result.reason}): not checked"}
+    else:
+        case = result.info.case
+        half_case = cases.apply_overrides(case, [f"process.speed_mm_per_s={0.5e3 * float(case.process.speed)!r}"])
+        half, _ = execute(half_case, out / HALF_SPEED, force=force, quiet=quiet, stream=stream, owner="run")
+        check = forming.quasi_static_check(result, half)
+        check.update(half_speed_dir=str(out / HALF_SPEED), half_speed_wall_time_s=half.wall_time_s)
+    result.summary["quasi_static_check"] = check
+    write_json(out / "summary.json", result.summary)
+    return check
+
+
+def _remove_stale_half_speed(out):
+    """A run without ``--verify-quasi-static`` removes the half-speed folder an earlier run of
+    ``jaxform run`` left there (only its own outputs), so that it is never read as this run's."""
+    from jaxform.io.output import MARKER
+
+    sub = pathlib.Path(out) / HALF_SPEED
+    marker = sub / MARKER
+    if not (marker.is_file() and marker.read_text().strip() == "run"):
+        return
+    for pattern in OUTPUTS:
+        for old in sub.glob(pattern):
+            if old.is_file():
+                old.unlink()
+    marker.unlink()
+    if not any(sub.iterdir()):
+        sub.rmdir()
+
+
+def _report_check(check, stream):
+    lim = check.get("limits", {})
+    if check.get("shear_p95_deg") is None:
+        print(f"  quasi-static check: NOT made: {check.get('reason')}", file=stream)
+        return
+    verdict = "quasi-static" if check["quasi_static"] else "NOT quasi-static"
+    print(f"  quasi-static check against half the speed ({check['half_speed_mm_per_s']:g} mm/s, "
+          f"in {check['half_speed_dir']}): shear-angle map {check['shear_p95_deg']:.2f}° at the 95th percentile "
+          f"(limit {lim['shear_p95_deg']:g}°), edge draw-in {100 * check['draw_in_edge_mid_rel']:.2f} % "
+          f"(limit {100 * lim['draw_in_edge_mid_rel']:g} %), flange wrinkles {check['flange_wrinkles'][0]} vs "
+          f"{check['flange_wrinkles'][1]}: {verdict}", file=stream)
+
+
 def report(result, written, out, stream=None):
     stream = stream or sys.stdout
     s = result.summary
@@ -138,6 +198,8 @@ def report(result, written, out, stream=None):
             print(f"  warning: not quasi-static by its own numbers: the kinetic energy reached {s['max_ke_ie']:.3g} x "
                   f"the internal energy over the last 80% of the stroke (quasi-static: below {QUASI_STATIC_KE_IE:g}); "
                   "inertia shapes this result. Lower process.speed_mm_per_s.", file=stream)
+    if "quasi_static_check" in s:
+        _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)
     for p in written:
         print(f"  {p}", file=stream)
@@ -147,9 +209,14 @@ def run(args) -> int:
     result, written = execute(args.case, args.out, force=args.force, quiet=args.quiet,
                               element_size=None if args.element_size_mm is None else args.element_size_mm * 1e-3,
                               overrides=args.overrides)
+    check = None
+    if args.verify_quasi_static:
+        check = verify_quasi_static(result, args.out, force=args.force, quiet=args.quiet)
+    else:
+        _remove_stale_half_speed(args.out)
     report(result, written, args.out)
     if result.complete:
-        return 0
+        return 0 if check is None or check["quasi_static"] else NOT_QUASI_STATIC
     from jaxform.cli import TERMINATED
 
     if result.reason == TERMINATED:

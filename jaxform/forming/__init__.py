@@ -6,7 +6,7 @@ Modules, along the data flow (imports point one way):
     presets   the paper's cases and ``--set`` overrides
     rig       Case -> (Model, State, RunInfo): mesh, fabrics, tools, contact, time step, built once
     fields    nodal fields of a state (pure, jit-able)
-    summary   draw-in, wrinkle count, symmetry, the JSON summary (host, numpy)
+    summary   draw-in, wrinkle count, symmetry, the JSON summary, the half-speed check (host, numpy)
     driver    pure chunks and rollout; the host run with frames and progress callbacks
 
 ``simulate(case)`` = ``run(build(jaxform.cases.resolve(case)))``.
@@ -18,9 +18,10 @@ from jaxform.forming.driver import ENERGY_FLOOR, FormingResult, rollout, run, ru
 from jaxform.forming.fields import node_average, state_fields
 from jaxform.forming.rig import (Rig, RunInfo, build, build_fabric, build_mesh, build_tools, grid_quads, ply_fabrics,
                                  punch_motion, stroke_time, with_fabric)
-from jaxform.forming.summary import draw_in, flange_census, flange_mask, summarize, symmetry_error
+from jaxform.forming.summary import (QUASI_STATIC_LIMITS, draw_in, flange_census, flange_mask, quasi_static_check,
+                                     summarize, symmetry_error)
 
 __all__ = ["Case", "ply_heights", "Rig", "RunInfo", "build", "build_fabric", "build_mesh", "build_tools", "grid_quads",
            "ply_fabrics", "punch_motion", "stroke_time", "with_fabric", "node_average", "state_fields", "ENERGY_FLOOR",
            "FormingResult", "rollout", "run", "run_steps", "simulate", "draw_in", "flange_census", "flange_mask",
-           "summarize", "symmetry_error"]
+           "summarize", "symmetry_error", "QUASI_STATIC_LIMITS", "quasi_static_check"]

@@ -1,5 +1,5 @@
 """What a forming run says, on the host (numpy): draw-in, the flange's wrinkle census,
-mirror symmetry, and the JSON-ready summary (SPEC section 6 keys)."""
+mirror symmetry, the JSON-ready summary (SPEC section 6 keys), and the half-speed check."""
 from __future__ import annotations
 
 import math
@@ -124,4 +124,45 @@ def summarize(result) -> dict:
     return s
 
 
-__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "summarize"]
+QUASI_STATIC_LIMITS = {"shear_p95_deg": 1.0, "draw_in_edge_mid_rel": 0.02, "flange_wrinkles_diff": 0}
+"""Halving the punch speed may change the final shear-angle map by less than 1° at the 95th
+percentile of the nodes, the edge mid-side draw-in by less than 2 %, and the number of flange
+wrinkles not at all (the quasi-static criterion of issue 13)."""
+
+
+def quasi_static_check(result, half) -> dict:
+    """How far a run is from quasi-static: its differences from ``half``, the same case (same
+    mesh) run at half the punch speed, both :class:`~jaxform.forming.driver.FormingResult` s.
+
+    Returns a JSON-ready dict: the two speeds (mm/s), ``shear_p95_deg`` (95th percentile over the
+    nodes of the final shear-angle difference), ``draw_in_edge_mid_rel`` (relative difference of
+    the edge mid-side draw-in), ``flange_wrinkles`` (the two counts) and ``flange_wrinkles_diff``,
+    the ``limits`` (:data:`QUASI_STATIC_LIMITS`) and ``quasi_static`` (all within them). A check
+    that cannot be made (a run incomplete, or no frame) says why in ``reason`` and is not passed.
+    """
+    out = {"speed_mm_per_s": 1e3 * float(result.info.case.process.speed),
+           "half_speed_mm_per_s": 1e3 * float(half.info.case.process.speed),
+           "limits": dict(QUASI_STATIC_LIMITS), "quasi_static": False, "reason": None}
+    for name, r in (("run", result), ("half-speed run", half)):
+        if not r.complete or not len(r.t):
+            out["reason"] = f"the {name} is incomplete ({r.reason}): no comparison"
+            return out
+    if len(result.info.x0) != len(half.info.x0):
+        raise ValueError(f"quasi_static_check: the runs have {len(result.info.x0)} and {len(half.info.x0)} nodes: "
+                         "they must share a mesh")
+    g = np.degrees(np.abs(np.asarray(result.fields["shear_angle"][-1]) - np.asarray(half.fields["shear_angle"][-1])))
+    d0, d1 = (float(r.summary["draw_in"]["edge_mid_m"]) for r in (result, half))
+    w0, w1 = (r.summary["flange_wrinkles"] for r in (result, half))
+    out.update(shear_p95_deg=float(np.percentile(g, 95)), draw_in_edge_mid_rel=abs(d0 - d1) / max(abs(d1), 1e-30),
+               draw_in_edge_mid_m=[d0, d1], flange_wrinkles=[w0, w1],
+               flange_wrinkles_diff=None if w0 is None or w1 is None else abs(int(w0) - int(w1)))
+    lim = QUASI_STATIC_LIMITS
+    out["quasi_static"] = bool(out["shear_p95_deg"] < lim["shear_p95_deg"]
+                               and out["draw_in_edge_mid_rel"] < lim["draw_in_edge_mid_rel"]
+                               and out["flange_wrinkles_diff"] is not None
+                               and out["flange_wrinkles_diff"] <= lim["flange_wrinkles_diff"])
+    return out
+
+
+__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "summarize", "QUASI_STATIC_LIMITS",
+           "quasi_static_check"]

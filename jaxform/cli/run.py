@@ -152,17 +152,13 @@ def verify_quasi_static(result, out, *, force=False, quiet=False, stream=None) -
 def _remove_stale_half_speed(out):
     """A run without ``--verify-quasi-static`` removes the half-speed folder an earlier run of
     ``jaxform run`` left there (only its own outputs), so that it is never read as this run's."""
-    from jaxform.io.output import MARKER
+    from jaxform.io.output import MARKER, remove_outputs, written_by
 
     sub = pathlib.Path(out) / HALF_SPEED
-    marker = sub / MARKER
-    if not (marker.is_file() and marker.read_text().strip() == "run"):
+    if not written_by(sub, "run"):
         return
-    for pattern in OUTPUTS:
-        for old in sub.glob(pattern):
-            if old.is_file():
-                old.unlink()
-    marker.unlink()
+    remove_outputs(sub, OUTPUTS)
+    (sub / MARKER).unlink()
     if not any(sub.iterdir()):
         sub.rmdir()
 

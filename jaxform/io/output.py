@@ -34,16 +34,26 @@ def prepare_output_dir(path, *, force: bool = False, owner: str = "jaxform", rep
         raise FileExistsError(f"output path {out} exists and is a file; choose a directory")
     marker = out / MARKER
     if out.exists() and any(out.iterdir()) and not force:
-        ours = marker.exists() and marker.read_text().strip() == owner
-        if not ours:
+        if not written_by(out, owner):
             raise FileExistsError(
                 f"output directory {out} is not empty and was not written by 'jaxform {owner}'; "
                 "choose another directory or pass --force to write into it"
             )
     out.mkdir(parents=True, exist_ok=True)
-    for pattern in replaces:
-        for old in out.glob(pattern):
-            if old.is_file():
-                old.unlink()
+    remove_outputs(out, replaces)
     marker.write_text(owner + "\n")
     return out
+
+
+def written_by(path, owner: str) -> bool:
+    """Whether directory ``path`` carries the marker of a run of ``jaxform owner``."""
+    marker = pathlib.Path(path) / MARKER
+    return marker.is_file() and marker.read_text().strip() == owner
+
+
+def remove_outputs(path, patterns) -> None:
+    """Remove the files in ``path`` matching the glob ``patterns`` (a command's own outputs)."""
+    for pattern in patterns:
+        for old in pathlib.Path(path).glob(pattern):
+            if old.is_file():
+                old.unlink()

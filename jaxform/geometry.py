@@ -27,7 +27,7 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
 
-__all__ = ["EZ", "safe_norm", "safe_normalize", "safe_sqrt", "tiny_sqrt", "safe_div", "closest_point_triangle",
+__all__ = ["EZ", "safe_norm", "safe_normalize", "safe_sqrt", "tiny_sqrt", "safe_div", "closest_point_triangle", "segments_sqdist",
            "point_triangle_sqdist", "closest_points_segments", "TriangleIndex", "build_triangle_index",
            "closest_triangle", "closest_point_on_mesh", "nearest_centroids", "quads_to_triangles"]
 
@@ -165,19 +165,29 @@ def point_triangle_sqdist(p, a, b, c):
     return jnp.sum(d * d, axis=-1)
 
 
-def closest_points_segments(p0, p1, q0, q1):
+def closest_points_segments(p0, p1, q0, q1, axis: int = -1):
     """``(s, t)`` (...): the closest points ``p0 + s (p1 - p0)`` and ``q0 + t (q1 - q0)`` of two
-    segments ((..., 3) ends, m, broadcast), ``s, t`` in [0, 1]; zero-length segments allowed;
+    segments ((..., 3) ends, m, broadcast; the coordinates along ``axis``, e.g. ``axis=0`` for
+    structure-of-arrays (3, ...) ends), ``s, t`` in [0, 1]; zero-length segments allowed;
     parallel ones (to rounding) meet in the middle of their overlap, not at an arbitrary end."""
     d1, d2, r = p1 - p0, q1 - q0, p0 - q0
-    a, e, b = jnp.sum(d1 * d1, -1), jnp.sum(d2 * d2, -1), jnp.sum(d1 * d2, -1)
-    c, f = jnp.sum(d1 * r, -1), jnp.sum(d2 * r, -1)
+    a, e, b = jnp.sum(d1 * d1, axis), jnp.sum(d2 * d2, axis), jnp.sum(d1 * d2, axis)
+    c, f = jnp.sum(d1 * r, axis), jnp.sum(d2 * r, axis)
     par = a * e - b * b <= 64.0 * jnp.finfo(a.dtype).eps * a * e  # sin^2 of the angle ~ 0: parallel
     lo, hi = jnp.maximum(jnp.minimum(-c, b - c), 0.0), jnp.minimum(jnp.maximum(-c, b - c), a)  # overlap, s a
     s = jnp.clip(jnp.where(par, safe_div(0.5 * (lo + hi), a), safe_div(b * f - c * e, a * e - b * b)), 0.0, 1.0)
     t = safe_div(b * s + f, e)
     s = jnp.where(t < 0.0, safe_div(-c, a), jnp.where(t > 1.0, safe_div(b - c, a), s))
     return jnp.clip(s, 0.0, 1.0), jnp.clip(t, 0.0, 1.0)
+
+
+def segments_sqdist(p0, p1, q0, q1, axis: int = -1):
+    """(...) squared distances between the segments ``p0 p1`` and ``q0 q1`` (ends as in
+    :func:`closest_points_segments`), m²."""
+    s, t = closest_points_segments(p0, p1, q0, q1, axis)
+    s, t = jnp.expand_dims(s, axis), jnp.expand_dims(t, axis)
+    d = p0 + s * (p1 - p0) - q0 - t * (q1 - q0)
+    return jnp.sum(d * d, axis=axis)
 
 
 def _sqdist_soa(p, t):

@@ -44,9 +44,9 @@ from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.contact import ContactResult, node_contact, ply_contact
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
-                              safe_normalize)
+                              safe_normalize, segments_sqdist)
 
-__all__ = ["SelfContactLoad", "Candidates", "self_contact_load", "edge_contact", "mesh_edges"]
+__all__ = ["SelfContactLoad", "Candidates", "self_contact_load", "edge_contact", "mesh_edges", "near_edges"]
 
 
 class Candidates(NamedTuple):
@@ -66,6 +66,38 @@ class Candidates(NamedTuple):
     active_nodes: Any
     active_edges: Any
     overflow: Any
+
+
+def near_edges(x0, edges, group, exclusion, *, chunk: int = 1 << 18) -> np.ndarray:
+    """(E, X) int32, -1 padded (X >= 1): for each edge of ``edges`` (E, 2) int on nodes ``x0``
+    (N, 3) m, the edges of its own ply (``group`` (E,) int) closer than ``exclusion`` (m) that
+    share no node with it: the pairs self-contact ignores (ordinary bending is not contact).
+    Host: a k-d tree on the edge midpoints (radius ``exclusion`` plus the longest edge), then the
+    exact segment distance of the pairs it returns."""
+    from scipy.spatial import cKDTree
+
+    x0, edges, group = np.asarray(x0, np.float64), np.asarray(edges, np.int64), np.asarray(group)
+    mid = x0[edges].mean(axis=1)
+    length = np.linalg.norm(x0[edges[:, 1]] - x0[edges[:, 0]], axis=1)
+    pairs = cKDTree(mid).query_pairs(float(exclusion) + float(length.max()), output_type="ndarray")
+    keep = group[pairs[:, 0]] == group[pairs[:, 1]]
+    keep &= ~np.any(edges[pairs[:, 0]][:, :, None] == edges[pairs[:, 1]][:, None, :], axis=(1, 2))
+    pairs = pairs[keep]
+    d2 = np.concatenate([np.asarray(_segments_sqdist_host(*(x0[edges[pairs[i:i + chunk, j], c]] for j in (0, 1)
+                                                                   for c in (0, 1))))
+                         for i in range(0, len(pairs), chunk)] or [np.zeros(0)])
+    pairs = pairs[d2 < float(exclusion) ** 2]
+    both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), np.int64)
+    count = np.bincount(both[:, 0], minlength=len(edges))
+    out = np.full((len(edges), max(1, int(count.max(initial=0)))), -1, np.int32)
+    order = np.argsort(both[:, 0], kind="stable")
+    both = both[order]
+    slot = np.arange(len(both)) - np.repeat(np.cumsum(count) - count, count)
+    out[both[:, 0], slot] = both[:, 1]
+    return out
+
+
+_segments_sqdist_host = jax.jit(segments_sqdist)
 
 
 def _compact(mask, size: int):
@@ -146,6 +178,9 @@ class SelfContactLoad:
         fallback: (N,) int32 a triangle each node may touch, far away in the reference.
         edges: (E, 2) int32 the edges of ``triangles``; edge_area: (E,) half their area share, m²;
         edge_group: (E,) int32 ply; edge_fallback: (E,) int32 a far edge of the same ply;
+        edge_near: (E, X) int32 the edges of the same ply closer than ``exclusion`` to each edge in
+            the reference and sharing no node with it, -1 padded (:func:`near_edges`, host-built:
+            a fixed table, so a refresh tests membership instead of reference distances);
         tri_edges: (F, 3) int32 the edges of each triangle.
         skin: () m; k (candidate triangles per node), edge_k (candidate edges per edge),
         refresh_every, cap, active_cap, edge_active_cap (room in :class:`Candidates`): static ints.
@@ -167,6 +202,7 @@ class SelfContactLoad:
     edge_area: Any
     edge_group: Any
     edge_fallback: Any
+    edge_near: Any
     tri_edges: Any
     skin: Any
     k: int = static_field(default=8)
@@ -192,18 +228,20 @@ class SelfContactLoad:
         return self.pair_ok[g, tg] & ~near
 
     def _seg_d2(self, x, a, b):
-        pa, pb = x[self.edges[a]][:, None], x[self.edges[b]]  # (B, 1, 2, 3), (B, M, 2, 3)
-        s, t = closest_points_segments(pa[..., 0, :], pa[..., 1, :], pb[..., 0, :], pb[..., 1, :])
-        d = pa[..., 0, :] + s[..., None] * (pa[..., 1, :] - pa[..., 0, :]) - pb[..., 0, :] - t[..., None] * (
-            pb[..., 1, :] - pb[..., 0, :])
-        return jnp.sum(d * d, axis=-1)
+        """(B, M) squared distances at ``x`` (N, 3) of edges ``a`` (B,) and ``b`` (B, M), m²
+        (structure of arrays: a trailing axis of 3 does not vectorise on CPU)."""
+        xs = x.T
+        ea, eb = self.edges[a], self.edges[b]  # (B, 2), (B, M, 2)
+        return segments_sqdist(xs[:, ea[:, 0]][:, :, None], xs[:, ea[:, 1]][:, :, None], xs[:, eb[..., 0]],
+                               xs[:, eb[..., 1]], axis=0)
 
     def edge_allowed(self, a, b):
         """(B, M) bool: edges ``a`` (B,) and ``b`` (B, M) may touch: their plies may, they share no
-        node, and they are not closer than ``exclusion`` in the reference (same ply)."""
+        node, and they are not closer than ``exclusion`` in the reference (same ply: not in
+        ``edge_near``)."""
         ea, eb = self.edges[a][:, None, :, None], self.edges[b][:, :, None, :]
         g, gb = self.edge_group[a][:, None], self.edge_group[b]
-        near = (g == gb) & (self._seg_d2(self.x0, a, b) < self.exclusion**2)
+        near = jnp.any(b[..., None] == self.edge_near[a][:, None, :], axis=-1)
         return self.pair_ok[g, gb] & ~jnp.any(ea == eb, axis=(2, 3)) & ~near
 
     def edge_candidates(self, x, node_ids):
@@ -296,15 +334,17 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
                                                                   x0[tris[:, 2]] - x0[tris[:, 0]]), axis=1))
     m0 = x0[edges].mean(axis=1)
     eg = group[edges[:, 0]]
+    excl = 2.0 * h if exclusion is None else float(exclusion)
     as_f = lambda a: jnp.asarray(a, dtype)  # noqa: E731
     as_i = lambda a: jnp.asarray(a, jnp.int32)  # noqa: E731
     return SelfContactLoad(
         slave=jnp.arange(len(x0), dtype=jnp.int32), triangles=as_i(tris), gap0=as_f(h),
         area=as_f(0.5 * np.asarray(node_area, np.float64)), params=params, group=as_i(group),
         tri_group=as_i(tg), pair_ok=jnp.asarray(ok), x0=as_f(x0), c0=as_f(c0),
-        exclusion=as_f(2.0 * h if exclusion is None else exclusion), fallback=as_i(_far(x0, group, c0, tg)),
+        exclusion=as_f(excl), fallback=as_i(_far(x0, group, c0, tg)),
         edges=as_i(edges), edge_area=as_f(0.5 * share), edge_group=as_i(eg),
-        edge_fallback=as_i(_far(m0, eg, m0, eg)), tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin),
+        edge_fallback=as_i(_far(m0, eg, m0, eg)), edge_near=as_i(near_edges(x0, edges, eg, excl)),
+        tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin),
         k=k, edge_k=edge_k, refresh_every=refresh_every, cap=cap,
         active_cap=max(64, int(np.ceil(active_fraction * len(x0)))),
         edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))))

@@ -11,7 +11,7 @@ import pytest
 from jaxform import broadphase, cases, contact
 from jaxform.geometry import closest_points_segments, point_triangle_sqdist
 from jaxform.metrics.intersections import triangulate
-from jaxform.self_contact import SelfContactLoad, edge_contact, self_contact_load
+from jaxform.self_contact import SelfContactLoad, edge_contact, mesh_edges, near_edges, self_contact_load
 from test_intersections import folded_strip
 
 H = 4e-4
@@ -153,6 +153,32 @@ def test_segment_closest_points_match_a_dense_sampling():
     brute = np.sqrt(np.min(np.sum((a[:, :, None] - b[:, None, :]) ** 2, axis=-1), axis=(1, 2)))
     step = 0.005 * (np.linalg.norm(p[:, 1] - p[:, 0], axis=1) + np.linalg.norm(p[:, 3] - p[:, 2], axis=1))
     assert np.all(d <= brute + 1e-12) and np.all(d >= brute - step)  # the sampling is off by a step at most
+
+
+def test_near_edges_table_matches_brute_force_reference_distances():
+    """The host table of edges excluded from edge contact (same ply, no shared node, closer than
+    the exclusion in the reference) against all pairs by dense sampling of the segments."""
+    lower, tri = _wavy_ply(7, 6e-3, 0.0, 0.8e-3, 0.0)
+    upper, _ = _wavy_ply(7, 6e-3, 0.3e-3, 0.8e-3, 0.4)
+    x0, tris = np.vstack([lower, upper]), np.vstack([tri, tri + len(lower)])
+    edges, _, _ = mesh_edges(tris, np.ones(len(tris)))
+    group = (edges[:, 0] >= len(lower)).astype(int)
+    excl = 1.3e-3
+    table = near_edges(x0, edges, group, excl)
+    got = {(i, int(j)) for i, row in enumerate(table) for j in row if j >= 0}
+    g = np.linspace(0.0, 1.0, 41)
+    pts = x0[edges[:, 0]][:, None] + g[None, :, None] * (x0[edges[:, 1]] - x0[edges[:, 0]])[:, None]  # (E, 41, 3)
+    d = np.sqrt(np.min(np.sum((pts[:, None, :, None] - pts[None, :, None, :]) ** 2, axis=-1), axis=(2, 3)))
+    shared = np.any(edges[:, None, :, None] == edges[None, :, None, :], axis=(2, 3))
+    ok = (group[:, None] == group[None, :]) & ~shared
+    length = np.linalg.norm(x0[edges[:, 1]] - x0[edges[:, 0]], axis=1)
+    step = 0.0125 * (length[:, None] + length[None, :])  # the sampling's error bound
+    sure_in = {(int(i), int(j)) for i, j in zip(*np.nonzero(ok & (d < excl)))}
+    sure_out = ok & (d - step > excl)
+    assert len(sure_in) > 2 * len(edges)  # a real test: many pairs inside, many near the limit outside
+    assert not any(sure_out[i, j] for i, j in got)
+    assert sure_in <= got
+    assert all(ok[i, j] for i, j in got)
 
 
 def _ridges(dist):

@@ -69,10 +69,12 @@ class FibreMass:
         weight: (2, T) ``A (E h)_f / X`` per fibre family and triangle (``X`` of the triangle's
             ply), kg·m²: ``K_t / X``, see :func:`stiffness_times`.
         degree: static, the Chebyshev degree ``n`` (``n - 1`` products with ``K_t`` per step).
+        factor: static, the factor ``s`` the membrane step limit grows by (for reports).
     """
 
     weight: Any
     degree: int = static_field()
+    factor: float = static_field(default=1.0)
 
 
 @functools.lru_cache(maxsize=None)
@@ -168,7 +170,7 @@ def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, dtype=jnp.float32
     for (t0, t1), fab, x in zip(shell.mesh.ply_tris, shell.fabrics, bounds):
         eh = _tension_stiffness(fab)
         w[:, t0:t1] = area[None, t0:t1] * eh[:, None] / x
-    return FibreMass(weight=jnp.asarray(w, dtype), degree=n)
+    return FibreMass(weight=jnp.asarray(w, dtype), degree=n, factor=factor)
 
 
 def fibre_units(xs, shell: Shell):

@@ -155,4 +155,8 @@ def test_contact_damping_bound_follows_the_explicit_stability_limit():
     cases.apply_overrides(case, ["contact.safety=0.95", "contact.damping_ratio=0.78"])
     with pytest.raises(ValueError, match="stable only up to 0.782"):
         cases.apply_overrides(case, ["contact.safety=0.95", "contact.damping_ratio=0.79"])
-    cases.apply_overrides(case, ["contact.damping_ratio=1.0"])
+    cases.apply_overrides(case, ["contact.safety=0.1", "contact.damping_ratio=1.0"])
+    # 'auto' may choose a safety up to 0.81 (four contacts sharing the step's budget): zeta <= 0.886
+    cases.apply_overrides(case, ["contact.damping_ratio=0.88"])
+    with pytest.raises(ValueError, match="contact.safety = auto the explicit step is stable only up to 0.886"):
+        cases.apply_overrides(case, ["contact.damping_ratio=1.0"])

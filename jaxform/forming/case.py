@@ -21,7 +21,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                optional punch_mesh = "file.stl", punch_mesh_units, punch_mesh_cell_mm
     [holder]   mode = "gap" | "force"; gap_mm (gap mode); force_N, mass_kg (force mode)
     [process]  stroke_mm, speed_mm_per_s (simulated punch speed), ramp_fraction, frames
-    [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety, slip_velocity_fraction,
+    [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety ("auto" or a number in
+               (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
                damping_ratio, optional self_contact (default true: folds lie on themselves)
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling (>= 1,
                default 1 = off: inertia added to fibre stretching only, the membrane limit of
@@ -103,12 +104,13 @@ class ProcessSpec:
 @dataclasses.dataclass(frozen=True)
 class ContactSpec:
     """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.contact.contact_params`), its
-    stability ``safety``, friction regularisation speed as a fraction of the punch speed, normal
+    stability ``safety`` (``(omega_c dt)^2`` of one contact; ``None``: automatic, chosen with the
+    time step by :func:`jaxform.forming.rig.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
     damping ratio; ``self_contact``: every ply with itself and the plies not next to it
     (:mod:`jaxform.self_contact`, on by default)."""
 
     penalty_stiffness: float | None
-    safety: float
+    safety: float | None
     slip_velocity_fraction: float
     damping_ratio: float
     self_contact: bool = True
@@ -175,7 +177,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
                "mass_kg": ("float", False)},
     "process": {"stroke_mm": ("float", True), "speed_mm_per_s": ("float", True),
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
-    "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("float", True),
+    "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
                 "self_contact": ("bool", False)},
     "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("float", False)},
@@ -345,16 +347,18 @@ def _build(d) -> Case:
     k = c["penalty_stiffness_Pa_per_m"]
     if k != "auto" and not k > 0:
         raise _err("contact.penalty_stiffness_Pa_per_m", k, "must be > 0 or 'auto'")
-    if not 0 < c["safety"] < 1:
-        raise _err("contact.safety", c["safety"], "must lie in (0, 1)")
+    safety = c["safety"]
+    if safety != "auto" and not 0 < safety < 1:
+        raise _err("contact.safety", safety, "must lie in (0, 1) or be 'auto'")
     _positive(d, "slip_velocity_fraction", "contact")
-    zeta_stable = _stable_damping_ratio(c["safety"]) if k == "auto" else math.inf
+    # 'auto' chooses at most AUTO_SAFETY_MAX (jaxform.forming.rig.contact_numerics)
+    zeta_stable = _stable_damping_ratio(AUTO_SAFETY_MAX if safety == "auto" else safety) if k == "auto" else math.inf
     if not 0 <= c["damping_ratio"] <= min(1.0, zeta_stable):
         raise _err("contact.damping_ratio", c["damping_ratio"],
                    f"must lie in [0, {min(1.0, zeta_stable):.3g}]: 1 is critical damping (beyond it the contact "
-                   "turns sticky)" + (f"; with contact.safety = {c['safety']:g} the explicit step is stable only up "
+                   "turns sticky)" + (f"; with contact.safety = {safety} the explicit step is stable only up "
                                       f"to {zeta_stable:.3g}" if zeta_stable < 1.0 else ""))
-    contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=c["safety"],
+    contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=None if safety == "auto" else safety,
                                slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"],
                                self_contact=c.get("self_contact", True))
 
@@ -375,6 +379,11 @@ def _build(d) -> Case:
     )
     _check_setup(case)
     return case
+
+
+AUTO_SAFETY_MAX = 0.81
+"""The largest contact safety ``(omega_c dt)^2`` the automatic choice can make: the step budget
+``(2 x 0.9)^2`` shared by :data:`jaxform.forming.rig.STACKED_CONTACTS` = 4 contacts."""
 
 
 def _stable_damping_ratio(safety: float) -> float:
@@ -486,7 +495,7 @@ def to_dict(case: Case) -> dict:
         "process": {"stroke_mm": _mm(p.stroke), "speed_mm_per_s": _mm(p.speed), "ramp_fraction": p.ramp_fraction,
                     "frames": p.frames},
         "contact": {"penalty_stiffness_Pa_per_m": "auto" if c.penalty_stiffness is None else c.penalty_stiffness,
-                    "safety": c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
+                    "safety": "auto" if c.safety is None else c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
                     "damping_ratio": c.damping_ratio, "self_contact": c.self_contact},
         "numerics": numerics,
     }

@@ -13,22 +13,23 @@ ply n the die, middle plies only their neighbours. Every tool contact acts at th
 (offset ``h / 2``) with each node's tributary area.
 
 Numerics (documented choices):
-* time step: ``dt_safety`` (0.75) times the shell's stable estimate, rounded down so that a whole
-  number of steps fills each frame interval; the automatic penalty stiffness caps it on coarse
-  meshes (:func:`build`);
+* time step and contact stiffness chosen together (:func:`contact_numerics`): ``dt_safety`` (0.75)
+  times the shell's stable estimate, unless a contact stiff enough to keep the penetration below
+  10% of the ply at 1e5 Pa, stable with four contacts pressing one node (a fold under the holder),
+  needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
 * gravity :data:`jaxform.units.GRAVITY` along -z, divided by the mass scaling so the physical
   weight is kept;
 * friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed, raised
   under high pressure so that explicit stick stays stable (:mod:`jaxform.contact`);
 * optional fibre-selective mass scaling ``numerics.fibre_mass_scaling`` (:mod:`jaxform.fibre_mass`):
-  the step's membrane limit grows by that factor (the contact cap then usually needs a larger
-  ``contact.safety``);
+  the step's membrane limit grows by that factor (the contact then often sets the step);
 * Case B holder: mass ``holder.mass_kg``, critically damped on its contact stiffness.
 """
 from __future__ import annotations
 
 import dataclasses
 import math
+import warnings
 from typing import Any, NamedTuple
 
 import jax
@@ -59,6 +60,7 @@ class RunInfo:
         n_ply_loads: number of ply–ply loads (after the three tools).
         stable_dt: stable estimate of the shell alone, s.
         bounds: :class:`HealthBounds` the driver checks after every chunk.
+        numerics: the step and contact stiffness chosen (:class:`ContactNumerics`).
     """
 
     case: Any
@@ -76,6 +78,7 @@ class RunInfo:
     n_ply_loads: int
     stable_dt: float
     bounds: HealthBounds
+    numerics: ContactNumerics | None = None
 
     @property
     def sub_steps(self) -> int:
@@ -261,24 +264,105 @@ def _edge_nodes(mesh: Mesh, n0: int):
     return np.asarray(mid) + n0, np.asarray(corners) + n0
 
 
-def _time_step(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float, samples_per_frame: int):
-    """``(dt, every, stroke time)``: the step filling each frame interval with a whole number of
-    host chunks. The automatic penalty stiffness k = safety rho_A / dt^2 must keep the penetration
-    under 1e5 Pa below 10% of the ply (:func:`jaxform.contact.contact_params` checks it): on coarse
-    meshes that caps dt."""
-    dt_max = dt_safety * stable if dt is None else float(dt)
+STEP_BUDGET = 0.9
+"""The explicit step's budget: ``omega dt <= 2 x STEP_BUDGET`` at the stiffest node, its shell and
+its contacts together (``omega^2`` adds up: the largest eigenvalue of ``M^-1 (K_shell + K_contact)``
+is at most the sum of theirs); the margin below 2 covers the contacts' normal damping."""
+STACKED_CONTACTS = 4
+"""Contact springs counted on one node: a node of a layer pressed between two others (a fold
+under the holder, a stack) has two, and the highest mode of a chain of such layers approaches
+``omega^2 = 4 k / m`` (Gershgorin), so 4 covers any depth of stacking."""
+AUTO_SAFETY = 0.1
+"""Automatic contact safety ``(omega_c dt)^2`` where it gives a stiff enough contact."""
+PENETRATION = (1.0e5, 0.1)
+"""``(pressure Pa, fraction of the ply thickness)``: the automatic contact keeps the penetration
+under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it)."""
+
+
+@dataclasses.dataclass(frozen=True)
+class ContactNumerics:
+    """The time step and contact stiffness chosen together (:func:`contact_numerics`).
+
+    Attributes:
+        dt_max: the largest step allowed, s (the frame intervals then round it down).
+        safety: contact safety ``(omega_c dt)^2`` at ``dt_max`` (``k = safety rho_A / dt^2``).
+        governed_by: ``"shell"`` (the shell's stable step times ``dt_safety``), ``"contact"``
+            (a stiff enough contact needs a smaller step), or ``"user"`` (a given ``dt``).
+        budget: ``(omega dt / 2)`` at the stiffest node with :data:`STACKED_CONTACTS` contacts,
+            at ``dt_max`` (stable below 1; the automatic choice keeps it <= :data:`STEP_BUDGET`).
+        why: one sentence for the summary.
+    """
+
+    dt_max: float
+    safety: float | None
+    governed_by: str
+    budget: float
+    why: str
+
+
+def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float) -> ContactNumerics:
+    """Choose the time step and the contact safety together (the automatic numerics of contact).
+
+    The contact must be stiff enough: ``k >= k_need = p / (f h)`` (:data:`PENETRATION`), and the
+    step stable with :data:`STACKED_CONTACTS` contacts on a node: ``(omega_s dt)^2 + n_c safety <=
+    (2 STEP_BUDGET)^2`` with ``omega_s = 2 / stable`` the shell's (fibre mass included) and
+    ``safety = k dt^2 / rho_A``. Automatic safety (``contact.safety = "auto"``): the step is
+    ``dt_safety x stable`` and the safety :data:`AUTO_SAFETY`, raised as far as needed for
+    ``k_need`` while the budget allows; beyond that the step shrinks to
+    ``dt = 2 STEP_BUDGET / sqrt(omega_s^2 + n_c k_need / rho_A)`` with ``k = k_need``. A given
+    safety or stiffness is kept (the step capped so that ``k >= k_need`` as before), and a budget
+    above 1 is reported (``budget``) and warned about.
+    """
     c = case.contact
-    if c.penalty_stiffness is None and dt is None:
-        rho_a = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
-        dt_contact = math.sqrt(c.safety * rho_a * 0.1 * float(case.ply_thickness) / 1.0e5)
-        dt_max = min(dt_max, 0.98 * dt_contact)
+    rho = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
+    k_need = PENETRATION[0] / (PENETRATION[1] * float(case.ply_thickness))
+    w_s2 = (2.0 / stable) ** 2
+    n_c, lim = STACKED_CONTACTS, (2.0 * STEP_BUDGET) ** 2
+
+    def budget(dt_, s_):
+        return 0.5 * math.sqrt(w_s2 * dt_**2 + n_c * s_)
+
+    if dt is not None:
+        s_ = c.safety if c.safety is not None else AUTO_SAFETY
+        if c.penalty_stiffness is not None:
+            s_ = float(c.penalty_stiffness) * float(dt) ** 2 / rho
+        return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
+                               budget(float(dt), s_), "the time step was given")
+    dt0 = dt_safety * stable
+    if c.penalty_stiffness is not None:
+        s_ = float(c.penalty_stiffness) * dt0**2 / rho
+        return ContactNumerics(dt0, None, "shell", budget(dt0, s_), "the contact stiffness was given; "
+                               f"step {dt_safety:g} x the shell's stable step")
+    if c.safety is not None:  # the user's safety: the step capped so that k >= k_need
+        dt_c = 0.98 * math.sqrt(c.safety * rho / k_need)
+        dt_ = min(dt0, dt_c)
+        return ContactNumerics(dt_, c.safety, "shell" if dt0 <= dt_c else "contact", budget(dt_, c.safety),
+                               f"contact.safety = {c.safety:g} was given")
+    s_need = k_need * dt0**2 / rho
+    s_room = (lim - w_s2 * dt0**2) / n_c
+    if s_need <= max(AUTO_SAFETY, s_room):
+        s_ = max(AUTO_SAFETY, s_need)
+        return ContactNumerics(dt0, s_, "shell", budget(dt0, s_),
+                               f"step {dt_safety:g} x the shell's stable step; contact safety {s_:.3g} "
+                               f"(penetration below {PENETRATION[1]:g} h at {PENETRATION[0]:.0e} Pa)")
+    dt_ = 2.0 * STEP_BUDGET / math.sqrt(w_s2 + n_c * k_need / rho)
+    s_ = k_need * dt_**2 / rho
+    return ContactNumerics(dt_, s_, "contact", budget(dt_, s_),
+                           f"a contact stiff enough for a penetration below {PENETRATION[1]:g} h at "
+                           f"{PENETRATION[0]:.0e} Pa and stable with {n_c} contacts on a node needs a step of "
+                           f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}")
+
+
+def _time_step(case: Case, numerics: ContactNumerics, samples_per_frame: int):
+    """``(dt, every, stroke time)``: the largest step up to ``numerics.dt_max`` filling each frame
+    interval with a whole number of host chunks."""
     T = stroke_time(case)
     n_int = int(case.process.frames) - 1
-    every = samples_per_frame * max(1, math.ceil(T / dt_max / (n_int * samples_per_frame)))
+    every = samples_per_frame * max(1, math.ceil(T / numerics.dt_max / (n_int * samples_per_frame)))
     return T / (n_int * every), every, T
 
 
-def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype):
+def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | None = None):
     """The contact loads in ``model.loads`` order and their initial holder state."""
     tools_rig = build_tools(case)
     h = float(case.ply_thickness)
@@ -288,7 +372,7 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype):
     speed = float(case.process.speed)
     n_if = 2 if case.n_plies > 1 else 1  # frictional contacts per node (stack: tool + ply, or two plies)
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
-                  damping_ratio=c.damping_ratio, safety=c.safety, interfaces=n_if)
+                  damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=n_if)
     params_tool = contact.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
     params_ply = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
     common["interfaces"] = n_if + 1  # a folded node: tools or plies, and a layer of itself
@@ -392,8 +476,14 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     ms = float(case.mass_scaling)
     fms = float(case.fibre_mass_scaling)
     stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
-    dt, every, T = _time_step(case, fabrics, stable, dt, dt_safety, samples_per_frame)
-    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype)
+    numerics = contact_numerics(case, fabrics, stable, dt, dt_safety)
+    if numerics.budget > 1.0:
+        warnings.warn(f"forming.build: the time step and contact stiffness given make a node between "
+                      f"{STACKED_CONTACTS} contacts unstable (omega dt / 2 = {numerics.budget:.2f} > 1); folds pressed "
+                      "under the holder may blow up. Use contact.safety = 'auto' or a smaller step.", RuntimeWarning,
+                      stacklevel=2)
+    dt, every, T = _time_step(case, numerics, samples_per_frame)
+    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, numerics.safety)
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
                                  fibre_mass_factor=fms)
@@ -405,7 +495,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
                    ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,
-                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case))
+                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case), numerics=numerics)
     return Rig(model, state, info)
 
 
@@ -422,5 +512,6 @@ def with_fabric(model, fabric):
     return model.replace(shell=model.shell.replace(fabrics=fabs))
 
 
-__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
+__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "ContactNumerics", "contact_numerics", "STEP_BUDGET",
+           "STACKED_CONTACTS", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
            "ply_fabrics", "punch_motion", "stroke_time", "build_tools", "with_fabric"]

@@ -63,6 +63,15 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
     return out
 
 
+def _step_choice(info) -> dict:
+    """How the step and the contact stiffness were chosen (:func:`jaxform.forming.rig.contact_numerics`)."""
+    n = getattr(info, "numerics", None)
+    if n is None:
+        return {}
+    return {"dt_governed_by": n.governed_by, "contact_safety": n.safety, "step_budget": n.budget,
+            "step_choice": n.why}
+
+
 def summarize(result) -> dict:
     """The summary of a :class:`~jaxform.forming.driver.FormingResult` (SPEC section 6 keys and more; JSON-ready)."""
     import jaxform
@@ -103,7 +112,7 @@ def summarize(result) -> dict:
                      # products with the fibre-tension stiffness per step: degree - 1
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,
-                     "punch_speed_m_per_s": float(case.process.speed)},
+                     "punch_speed_m_per_s": float(case.process.speed), **_step_choice(info)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,

@@ -199,6 +199,8 @@ def test_case_keys_for_fibre_mass_are_checked_and_round_trip():
     assert case.fibre_mass_scaling == 1.0
     c2 = cases.apply_overrides(case, ["numerics.fibre_mass_scaling=3"])
     assert cases.loads(cases.to_toml(c2)).fibre_mass_scaling == 3.0
+    c3 = cases.apply_overrides(case, ['numerics.fibre_mass_scaling="auto"'])
+    assert c3.fibre_mass_scaling is None and cases.loads(cases.to_toml(c3)).fibre_mass_scaling is None
     with pytest.raises(ValueError, match="numerics.fibre_mass_scaling"):
         cases.apply_overrides(case, ["numerics.fibre_mass_scaling=0.5"])
     with pytest.raises(ValueError, match="numerics.fibre_mass_iters"):  # the degree follows from the factor
@@ -230,3 +232,21 @@ def test_rollout_with_fibre_mass_differentiates_like_finite_differences():
     fd = float(central_difference(jax.jit(loss), e0, 1e-4 * e0))
     assert g != 0.0
     assert g == pytest.approx(fd, rel=1e-5)
+
+
+@pytest.mark.parametrize("name, size_mm, factor", [("case-a-woven-nlbm", 2.0, 12.0), ("case-a-ncf-nlbm", 2.0, 6.0),
+                                                    ("case-a-woven-membrane", 4.0, 12.0)])
+def test_automatic_fibre_mass_stops_where_bending_sets_the_step(name, size_mm, factor):
+    """'auto': the smallest factor bringing the step within 25% of the bending limit, at most 12
+    (woven wants 23 at 2 mm; the NCF, 20x stiffer in bending, 5.8 -> 6; membrane only: the cap)."""
+    from jaxform.forming import rig
+    from jaxform.shell import stable_time_step
+
+    case = cases.with_element_size(cases.load(name), size_mm * 1e-3)
+    shell = Shell.build(rig.build_mesh(case), rig.ply_fabrics(case))
+    s = rig.auto_fibre_mass(shell)
+    assert s == factor
+    if factor < rig.FIBRE_MASS_MAX:  # within 25% of the bending-only step, and not more factor than that needs
+        bending_only = stable_time_step(shell, safety=1.0, fibre_mass_factor=1e9)
+        assert stable_time_step(shell, safety=1.0, fibre_mass_factor=s) >= bending_only / 1.25
+        assert stable_time_step(shell, safety=1.0, fibre_mass_factor=s - 1) < bending_only / 1.25

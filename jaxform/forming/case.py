@@ -24,7 +24,7 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety ("auto" or a number in
                (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
                damping_ratio, optional self_contact (default true: folds lie on themselves)
-    [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling (>= 1,
+    [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto" or >= 1,
                default 1 = off: inertia added to fibre stretching only, the membrane limit of
                the step grows by that factor; see jaxform.fibre_mass)
 
@@ -132,7 +132,7 @@ class Case:
     contact: ContactSpec
     dtype: str
     mass_scaling: float
-    fibre_mass_scaling: float = 1.0
+    fibre_mass_scaling: float | None = 1.0  # None: automatic (jaxform.forming.rig.auto_fibre_mass)
 
     @property
     def n_plies(self) -> int:
@@ -180,7 +180,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
                 "self_contact": ("bool", False)},
-    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("float", False)},
+    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False)},
 }
 _VOCE_KEYS = ("b_inf_Nm", "m0_N", "kappa0_per_m")
 
@@ -367,15 +367,15 @@ def _build(d) -> Case:
         raise _err("numerics.dtype", n["dtype"], "must be 'float32' or 'float64'")
     _positive(d, "mass_scaling", "numerics")
     fms = n.get("fibre_mass_scaling", 1.0)
-    if not (math.isfinite(fms) and fms >= 1.0):
-        raise _err("numerics.fibre_mass_scaling", fms, "must be a number >= 1 (1 = off)")
+    if fms != "auto" and not (math.isfinite(fms) and fms >= 1.0):
+        raise _err("numerics.fibre_mass_scaling", fms, "must be a number >= 1 (1 = off) or 'auto'")
 
     orient = tuple(math.radians(a) for a in d["plies"]["orientations_deg"])
     case = Case(
         name=d[""]["name"], description=d[""].get("description", ""), fabric=fabric, orientations=orient,
         blank_size=d["blank"]["size_mm"] * _MM, element_size=d["blank"]["element_size_mm"] * _MM,
         tools=tools_spec, holder=holder, process=process, contact=contact_spec,
-        dtype=n["dtype"], mass_scaling=n["mass_scaling"], fibre_mass_scaling=fms,
+        dtype=n["dtype"], mass_scaling=n["mass_scaling"], fibre_mass_scaling=None if fms == "auto" else fms,
     )
     _check_setup(case)
     return case
@@ -483,7 +483,8 @@ def to_dict(case: Case) -> dict:
     if h.mass is not None:
         holder["mass_kg"] = h.mass
     p, c = case.process, case.contact
-    numerics = {"dtype": case.dtype, "mass_scaling": case.mass_scaling, "fibre_mass_scaling": case.fibre_mass_scaling}
+    numerics = {"dtype": case.dtype, "mass_scaling": case.mass_scaling,
+                "fibre_mass_scaling": "auto" if case.fibre_mass_scaling is None else case.fibre_mass_scaling}
     return {
         "name": case.name,
         "description": case.description,

@@ -61,6 +61,7 @@ class RunInfo:
         stable_dt: stable estimate of the shell alone, s.
         bounds: :class:`HealthBounds` the driver checks after every chunk.
         numerics: the step and contact stiffness chosen (:class:`ContactNumerics`).
+        fibre_mass_factor: the fibre-mass factor used (the case's, or :func:`auto_fibre_mass`).
     """
 
     case: Any
@@ -79,6 +80,7 @@ class RunInfo:
     stable_dt: float
     bounds: HealthBounds
     numerics: ContactNumerics | None = None
+    fibre_mass_factor: float = 1.0
 
     @property
     def sub_steps(self) -> int:
@@ -262,6 +264,32 @@ def _edge_nodes(mesh: Mesh, n0: int):
     mid = [j_mid * nx + nx - 1, j_mid * nx, (ny - 1) * nx + i_mid, i_mid]
     corners = [0, nx - 1, (ny - 1) * nx, ny * nx - 1]
     return np.asarray(mid) + n0, np.asarray(corners) + n0
+
+
+FIBRE_MASS_MAX = 12.0
+"""The largest automatic fibre-mass factor: the largest run to completion here (woven Case A,
+2 mm). Beyond the bending limit more is useless, and the position-dependent inverse mass can pump
+energy into a free corner that whips in-plane: NCF Case A at 2 mm with 12 blew up there at 79% of
+the stroke (a 3 m/s corner oscillation growing to 170 m/s in 150 steps) although the step was
+within the linear limit (omega dt / 2 = 0.24 at that state); with 6, or half the step, it did not."""
+FIBRE_MASS_RESERVE = 1.25
+"""The automatic fibre-mass factor brings the step to within this factor of the bending limit."""
+
+
+def auto_fibre_mass(shell: Shell, mass_scale=1.0) -> float:
+    """``numerics.fibre_mass_scaling = "auto"``: the smallest factor ``s`` that brings the shell's
+    stable step to within :data:`FIBRE_MASS_RESERVE` of its bending limit (``sqrt(omega_b^2 +
+    (omega_m / s)^2) <= 1.25 omega_b``, i.e. ``s >= omega_m / (0.75 omega_b)``: more would buy
+    less than 25% of step), at most :data:`FIBRE_MASS_MAX`, rounded up to a whole number; 1 where
+    the membrane does not set the step (``omega_m / omega_b`` grows with the element size). Woven
+    Case A: 12 at 8, 4 and 2 mm (88, 45 and 23 wanted); NCF (20 x stiffer in bending): 12 at 8 and
+    4 mm (22, 12 wanted), 6 at 2 mm (5.8); membrane only: 12."""
+    from jaxform.shell import _ply_frequencies
+
+    need = 1.0
+    for wm, wb in _ply_frequencies(shell, mass_scale):
+        need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
+    return float(min(FIBRE_MASS_MAX, math.ceil(need)))
 
 
 STEP_BUDGET = 0.9
@@ -474,7 +502,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     fabrics = ply_fabrics(case, fabric)
     shell = Shell.build(mesh, fabrics)
     ms = float(case.mass_scaling)
-    fms = float(case.fibre_mass_scaling)
+    fms = auto_fibre_mass(shell, ms) if case.fibre_mass_scaling is None else float(case.fibre_mass_scaling)
     stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
     numerics = contact_numerics(case, fabrics, stable, dt, dt_safety)
     if numerics.budget > 1.0:
@@ -495,7 +523,8 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
                    ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,
-                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case), numerics=numerics)
+                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case), numerics=numerics,
+                   fibre_mass_factor=fms)
     return Rig(model, state, info)
 
 
@@ -512,6 +541,7 @@ def with_fabric(model, fabric):
     return model.replace(shell=model.shell.replace(fabrics=fabs))
 
 
-__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "ContactNumerics", "contact_numerics", "STEP_BUDGET",
+__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "ContactNumerics", "contact_numerics", "STEP_BUDGET", "auto_fibre_mass",
+           "FIBRE_MASS_MAX",
            "STACKED_CONTACTS", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
            "ply_fabrics", "punch_motion", "stroke_time", "build_tools", "with_fabric"]

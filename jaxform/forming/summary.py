@@ -108,7 +108,8 @@ def summarize(result) -> dict:
         "numerics": {"dt_s": info.dt, "stable_dt_s": info.stable_dt, "n_steps": info.n_steps,
                      "steps_done": int(h["step"][-1]) if len(h["step"]) else 0, "stroke_time_s": T,
                      "nodes": int(len(info.x0)), "mass_scaling": float(case.mass_scaling),
-                     "fibre_mass_scaling": float(case.fibre_mass_scaling),
+                     "fibre_mass_scaling": float(getattr(info, "fibre_mass_factor", case.fibre_mass_scaling or 1.0)),
+                     "fibre_mass_choice": "auto" if case.fibre_mass_scaling is None else "given",
                      # products with the fibre-tension stiffness per step: degree - 1
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,

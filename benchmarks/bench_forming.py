@@ -26,9 +26,12 @@ import jax
 import numpy as np
 
 COARSE_MM = 8.0
-# fibre-selective mass scaling (jaxform.fibre_mass) with the contact safety that lets the step grow
+# fibre-selective mass scaling (jaxform.fibre_mass). At 4 mm the setting the README's OpenRadioss
+# figures were measured with (a contact safety over today's step budget: omega dt / 2 = 1.03 for a
+# node four contacts press; kept so that the figures stay comparable); at 2 mm the automatic
+# numerics (fibre mass and contact stiffness chosen by the rig: jaxform.forming.rig)
 FIBRE_MASS_4MM = ("numerics.fibre_mass_scaling=7", "contact.safety=0.9")
-FIBRE_MASS_2MM = ("numerics.fibre_mass_scaling=12", "contact.safety=0.5")
+FIBRE_MASS_2MM = ('numerics.fibre_mass_scaling="auto"',)
 
 
 def _case(name, size_mm, *overrides):

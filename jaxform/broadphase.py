@@ -17,7 +17,7 @@ that a thin sheet in a large box costs nothing for its empty cells):
    keep the ``K`` nearest centroids; a slot left empty gets the point's ``fallback`` triangle.
 
 Cost per refresh: a sort of the F keys and ``27 * cap * pages`` distance tests per point, i.e.
-``O(N + F log F)`` against ``O(N F)`` for :func:`jaxform.geometry.nearest_centroids`. The
+``O(N + F log F)`` against ``O(N F)`` for :func:`nearest_centroids` (the brute-force reference). The
 candidates stay valid while no point has moved by more than half the skin (``reach`` minus the
 contact distance) since the refresh (:func:`moved_beyond`, the Verlet-list criterion: it ties the
 refresh to the largest node speed). The search is integer bookkeeping: no gradient flows through
@@ -31,7 +31,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-__all__ = ["cell_size", "grid_keys", "cell_ranges", "candidates", "moved_beyond", "SearchState", "initial_search_state",
+__all__ = ["nearest_centroids", "cell_size", "grid_keys", "cell_ranges", "candidates", "moved_beyond", "SearchState", "initial_search_state",
            "initial_state_of", "refreshed"]
 
 _BITS = 10
@@ -136,6 +136,37 @@ def candidates(points, tri_x, k: int, reach, *, mask=None, refine=None, fallback
 
     ids, found = jax.lax.map(block, pid)
     return ids.reshape(-1, k)[:n].astype(jnp.int32), found.reshape(-1, k)[:n]
+
+
+def nearest_centroids(points, centroids, k: int, chunk: int = 1024):
+    """The ``k`` nearest centroids of each point: a candidate table for a *moving* mesh.
+
+    Unlike :func:`jaxform.geometry.closest_triangle` nothing is certified (the closest triangle is among the
+    candidates when the mesh is fine against the query distance); it needs no host-built index,
+    so it can be refreshed inside ``jit`` (the reference the cell grid replaces). Cost ``O(N F)``, ``chunk`` points at
+    a time.
+
+    Args:
+        points: (N, 3) positions, m.
+        centroids: (F, 3) triangle centroids, m.
+        k: candidates per point (static; capped at F).
+
+    Returns:
+        (N, k) int32 triangle ids, nearest first.
+    """
+    ps = jnp.asarray(points)
+    cen = jnp.asarray(centroids)
+    n = ps.shape[0]
+    chunk = int(max(1, min(chunk, n)))
+    pad = (-n) % chunk
+    ps = jnp.concatenate([ps, jnp.zeros((pad, 3), ps.dtype)]).reshape(-1, chunk, 3)
+    k = int(min(k, cen.shape[0]))
+
+    def block(p):
+        d2 = jnp.sum((p[:, None, :] - cen[None, :, :]) ** 2, axis=-1)
+        return jax.lax.top_k(-d2, k)[1].astype(jnp.int32)
+
+    return jax.lax.map(block, ps).reshape(-1, k)[:n]
 
 
 def moved_beyond(x, x_ref, distance):

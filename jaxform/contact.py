@@ -53,7 +53,6 @@ from jaxform import broadphase, tools, validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
-    nearest_centroids,
     quads_to_triangles,
     safe_norm,
     safe_normalize,
@@ -216,7 +215,7 @@ def tool_pose(tool, t):
 def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
     """Candidate table for ply–ply contact: the ``k`` triangles with the nearest centroids.
 
-    Cost ``O(N_s F)`` (``chunk`` slave nodes at a time, :func:`jaxform.geometry.nearest_centroids`):
+    Cost ``O(N_s F)`` (``chunk`` slave nodes at a time, :func:`jaxform.broadphase.nearest_centroids`):
     refresh it every so many steps, not every step (plies slide by less than an element between
     refreshes). The plies move, so the host-built certified index of
     :func:`jaxform.geometry.closest_triangle` does not apply here.
@@ -232,7 +231,7 @@ def nearest_faces(x, slave, triangles, k: int, chunk: int = 1024):
     """
     x = jnp.asarray(x)
     cen = jnp.mean(x[jnp.asarray(triangles)], axis=1)
-    return nearest_centroids(x[jnp.asarray(slave)], cen, k, chunk)
+    return broadphase.nearest_centroids(x[jnp.asarray(slave)], cen, k, chunk)
 
 
 def _ply_node(p, vp, tri_x, tri_v, side, gap0, area, params):

@@ -14,7 +14,6 @@ Pure JAX; the triangle index is built with numpy on the host from concrete array
   closer than the distance found; uncertified points get a wider second pass, then an exhaustive
   search (``lax.while_loop`` over fixed-size batches): exact for every point. ``TriangleIndex(tri)``
   without clusters (e.g. traced triangles) is the brute-force mode of the same search.
-* :func:`nearest_centroids`: uncertified candidates of a *moving* mesh (ply–ply contact).
 * :func:`closest_points_segments`: closest points of two segments (Ericson 5.1.9; edge–edge contact).
 """
 from __future__ import annotations
@@ -29,7 +28,7 @@ from jaxform._pytree import pytree_dataclass, static_field
 
 __all__ = ["EZ", "safe_norm", "safe_normalize", "safe_sqrt", "tiny_sqrt", "safe_div", "closest_point_triangle", "segments_sqdist",
            "point_triangle_sqdist", "closest_points_segments", "TriangleIndex", "build_triangle_index",
-           "closest_triangle", "closest_point_on_mesh", "nearest_centroids", "quads_to_triangles"]
+           "closest_triangle", "closest_point_on_mesh", "quads_to_triangles"]
 
 EZ = (0.0, 0.0, 1.0)  # the fallback direction of safe_normalize
 
@@ -499,37 +498,3 @@ def quads_to_triangles(faces):
     if faces.shape[1] == 3:
         return faces
     return jnp.concatenate([faces[:, jnp.array([0, 1, 2])], faces[:, jnp.array([0, 2, 3])]], axis=0)
-
-
-# --- Candidate triangles of a moving mesh (uncertified) ---
-
-
-def nearest_centroids(points, centroids, k: int, chunk: int = 1024):
-    """The ``k`` nearest centroids of each point: a candidate table for a *moving* mesh.
-
-    Unlike :func:`closest_triangle` nothing is certified (the closest triangle is among the
-    candidates when the mesh is fine against the query distance); it needs no host-built index,
-    so it can be refreshed inside ``jit`` (ply–ply contact). Cost ``O(N F)``, ``chunk`` points at
-    a time.
-
-    Args:
-        points: (N, 3) positions, m.
-        centroids: (F, 3) triangle centroids, m.
-        k: candidates per point (static; capped at F).
-
-    Returns:
-        (N, k) int32 triangle ids, nearest first.
-    """
-    ps = jnp.asarray(points)
-    cen = jnp.asarray(centroids)
-    n = ps.shape[0]
-    chunk = int(max(1, min(chunk, n)))
-    pad = (-n) % chunk
-    ps = jnp.concatenate([ps, jnp.zeros((pad, 3), ps.dtype)]).reshape(-1, chunk, 3)
-    k = int(min(k, cen.shape[0]))
-
-    def block(p):
-        d2 = jnp.sum((p[:, None, :] - cen[None, :, :]) ** 2, axis=-1)
-        return jax.lax.top_k(-d2, k)[1].astype(jnp.int32)
-
-    return jax.lax.map(block, ps).reshape(-1, k)[:n]

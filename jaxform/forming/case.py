@@ -105,7 +105,7 @@ class ProcessSpec:
 class ContactSpec:
     """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.contact.contact_params`), its
     stability ``safety`` (``(omega_c dt)^2`` of one contact; ``None``: automatic, chosen with the
-    time step by :func:`jaxform.forming.rig.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
+    time step by :func:`jaxform.forming.numerics.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
     damping ratio; ``self_contact``: every ply with itself and the plies not next to it
     (:mod:`jaxform.self_contact`, on by default)."""
 
@@ -132,7 +132,7 @@ class Case:
     contact: ContactSpec
     dtype: str
     mass_scaling: float
-    fibre_mass_scaling: float | None = 1.0  # None: automatic (jaxform.forming.rig.auto_fibre_mass)
+    fibre_mass_scaling: float | None = 1.0  # None: automatic (jaxform.forming.numerics.auto_fibre_mass)
 
     @property
     def n_plies(self) -> int:
@@ -351,7 +351,7 @@ def _build(d) -> Case:
     if safety != "auto" and not 0 < safety < 1:
         raise _err("contact.safety", safety, "must lie in (0, 1) or be 'auto'")
     _positive(d, "slip_velocity_fraction", "contact")
-    # 'auto' chooses at most AUTO_SAFETY_MAX (jaxform.forming.rig.contact_numerics)
+    # 'auto' chooses at most AUTO_SAFETY_MAX (jaxform.forming.numerics.contact_numerics)
     zeta_stable = _stable_damping_ratio(AUTO_SAFETY_MAX if safety == "auto" else safety) if k == "auto" else math.inf
     if not 0 <= c["damping_ratio"] <= min(1.0, zeta_stable):
         raise _err("contact.damping_ratio", c["damping_ratio"],
@@ -383,7 +383,7 @@ def _build(d) -> Case:
 
 AUTO_SAFETY_MAX = 0.81
 """The largest contact safety ``(omega_c dt)^2`` the automatic choice can make: the step budget
-``(2 x 0.9)^2`` shared by :data:`jaxform.forming.rig.STACKED_CONTACTS` = 4 contacts."""
+``(2 x 0.9)^2`` shared by :data:`jaxform.forming.numerics.STACKED_CONTACTS` = 4 contacts."""
 
 
 def _stable_damping_ratio(safety: float) -> float:

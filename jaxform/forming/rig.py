@@ -13,7 +13,7 @@ ply n the die, middle plies only their neighbours. Every tool contact acts at th
 (offset ``h / 2``) with each node's tributary area.
 
 Numerics (documented choices):
-* time step and contact stiffness chosen together (:func:`contact_numerics`): ``dt_safety`` (0.75)
+* time step and contact stiffness chosen together (:func:`jaxform.forming.numerics.contact_numerics`): ``dt_safety`` (0.75)
   times the shell's stable estimate, unless a contact stiff enough to keep the penetration below
   10% of the ply at 1e5 Pa, stable with four contacts pressing one node (a fold under the holder),
   needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
@@ -38,6 +38,8 @@ import numpy as np
 
 from jaxform import contact, integrate, units
 from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
+from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNumerics, auto_fibre_mass,
+                                      contact_numerics)
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
 from jaxform.shell import Shell, stable_time_step
@@ -61,7 +63,8 @@ class RunInfo:
         stable_dt: stable estimate of the shell alone, s.
         bounds: :class:`HealthBounds` the driver checks after every chunk.
         numerics: the step and contact stiffness chosen (:class:`ContactNumerics`).
-        fibre_mass_factor: the fibre-mass factor used (the case's, or :func:`auto_fibre_mass`).
+        fibre_mass_factor: the fibre-mass factor used (the case's, or
+            :func:`jaxform.forming.numerics.auto_fibre_mass`).
     """
 
     case: Any
@@ -266,121 +269,6 @@ def _edge_nodes(mesh: Mesh, n0: int):
     return np.asarray(mid) + n0, np.asarray(corners) + n0
 
 
-FIBRE_MASS_MAX = 12.0
-"""The largest automatic fibre-mass factor: the largest run to completion here (woven Case A,
-2 mm). Beyond the bending limit more is useless, and the position-dependent inverse mass can pump
-energy into a free corner that whips in-plane: NCF Case A at 2 mm with 12 blew up there at 79% of
-the stroke (a 3 m/s corner oscillation growing to 170 m/s in 150 steps) although the step was
-within the linear limit (omega dt / 2 = 0.24 at that state); with 6, or half the step, it did not."""
-FIBRE_MASS_RESERVE = 1.25
-"""The automatic fibre-mass factor brings the step to within this factor of the bending limit."""
-
-
-def auto_fibre_mass(shell: Shell, mass_scale=1.0) -> float:
-    """``numerics.fibre_mass_scaling = "auto"``: the smallest factor ``s`` that brings the shell's
-    stable step to within :data:`FIBRE_MASS_RESERVE` of its bending limit (``sqrt(omega_b^2 +
-    (omega_m / s)^2) <= 1.25 omega_b``, i.e. ``s >= omega_m / (0.75 omega_b)``: more would buy
-    less than 25% of step), at most :data:`FIBRE_MASS_MAX`, rounded up to a whole number; 1 where
-    the membrane does not set the step (``omega_m / omega_b`` grows with the element size). Woven
-    Case A: 12 at 8, 4 and 2 mm (88, 45 and 23 wanted); NCF (20 x stiffer in bending): 12 at 8 and
-    4 mm (22, 12 wanted), 6 at 2 mm (5.8); membrane only: 12."""
-    from jaxform.shell import _ply_frequencies
-
-    need = 1.0
-    for wm, wb in _ply_frequencies(shell, mass_scale):
-        need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
-    return float(min(FIBRE_MASS_MAX, math.ceil(need)))
-
-
-STEP_BUDGET = 0.9
-"""The explicit step's budget: ``omega dt <= 2 x STEP_BUDGET`` at the stiffest node, its shell and
-its contacts together (``omega^2`` adds up: the largest eigenvalue of ``M^-1 (K_shell + K_contact)``
-is at most the sum of theirs); the margin below 2 covers the contacts' normal damping."""
-STACKED_CONTACTS = 4
-"""Contact springs counted on one node: a node of a layer pressed between two others (a fold
-under the holder, a stack) has two, and the highest mode of a chain of such layers approaches
-``omega^2 = 4 k / m`` (Gershgorin), so 4 covers any depth of stacking."""
-AUTO_SAFETY = 0.1
-"""Automatic contact safety ``(omega_c dt)^2`` where it gives a stiff enough contact."""
-PENETRATION = (1.0e5, 0.1)
-"""``(pressure Pa, fraction of the ply thickness)``: the automatic contact keeps the penetration
-under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it)."""
-
-
-@dataclasses.dataclass(frozen=True)
-class ContactNumerics:
-    """The time step and contact stiffness chosen together (:func:`contact_numerics`).
-
-    Attributes:
-        dt_max: the largest step allowed, s (the frame intervals then round it down).
-        safety: contact safety ``(omega_c dt)^2`` at ``dt_max`` (``k = safety rho_A / dt^2``).
-        governed_by: ``"shell"`` (the shell's stable step times ``dt_safety``), ``"contact"``
-            (a stiff enough contact needs a smaller step), or ``"user"`` (a given ``dt``).
-        budget: ``(omega dt / 2)`` at the stiffest node with :data:`STACKED_CONTACTS` contacts,
-            at ``dt_max`` (stable below 1; the automatic choice keeps it <= :data:`STEP_BUDGET`).
-        why: one sentence for the summary.
-    """
-
-    dt_max: float
-    safety: float | None
-    governed_by: str
-    budget: float
-    why: str
-
-
-def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float) -> ContactNumerics:
-    """Choose the time step and the contact safety together (the automatic numerics of contact).
-
-    The contact must be stiff enough: ``k >= k_need = p / (f h)`` (:data:`PENETRATION`), and the
-    step stable with :data:`STACKED_CONTACTS` contacts on a node: ``(omega_s dt)^2 + n_c safety <=
-    (2 STEP_BUDGET)^2`` with ``omega_s = 2 / stable`` the shell's (fibre mass included) and
-    ``safety = k dt^2 / rho_A``. Automatic safety (``contact.safety = "auto"``): the step is
-    ``dt_safety x stable`` and the safety :data:`AUTO_SAFETY`, raised as far as needed for
-    ``k_need`` while the budget allows; beyond that the step shrinks to
-    ``dt = 2 STEP_BUDGET / sqrt(omega_s^2 + n_c k_need / rho_A)`` with ``k = k_need``. A given
-    safety or stiffness is kept (the step capped so that ``k >= k_need`` as before), and a budget
-    above 1 is reported (``budget``) and warned about.
-    """
-    c = case.contact
-    rho = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
-    k_need = PENETRATION[0] / (PENETRATION[1] * float(case.ply_thickness))
-    w_s2 = (2.0 / stable) ** 2
-    n_c, lim = STACKED_CONTACTS, (2.0 * STEP_BUDGET) ** 2
-
-    def budget(dt_, s_):
-        return 0.5 * math.sqrt(w_s2 * dt_**2 + n_c * s_)
-
-    if dt is not None:
-        s_ = c.safety if c.safety is not None else AUTO_SAFETY
-        if c.penalty_stiffness is not None:
-            s_ = float(c.penalty_stiffness) * float(dt) ** 2 / rho
-        return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
-                               budget(float(dt), s_), "the time step was given")
-    dt0 = dt_safety * stable
-    if c.penalty_stiffness is not None:
-        s_ = float(c.penalty_stiffness) * dt0**2 / rho
-        return ContactNumerics(dt0, None, "shell", budget(dt0, s_), "the contact stiffness was given; "
-                               f"step {dt_safety:g} x the shell's stable step")
-    if c.safety is not None:  # the user's safety: the step capped so that k >= k_need
-        dt_c = 0.98 * math.sqrt(c.safety * rho / k_need)
-        dt_ = min(dt0, dt_c)
-        return ContactNumerics(dt_, c.safety, "shell" if dt0 <= dt_c else "contact", budget(dt_, c.safety),
-                               f"contact.safety = {c.safety:g} was given")
-    s_need = k_need * dt0**2 / rho
-    s_room = (lim - w_s2 * dt0**2) / n_c
-    if s_need <= max(AUTO_SAFETY, s_room):
-        s_ = max(AUTO_SAFETY, s_need)
-        return ContactNumerics(dt0, s_, "shell", budget(dt0, s_),
-                               f"step {dt_safety:g} x the shell's stable step; contact safety {s_:.3g} "
-                               f"(penetration below {PENETRATION[1]:g} h at {PENETRATION[0]:.0e} Pa)")
-    dt_ = 2.0 * STEP_BUDGET / math.sqrt(w_s2 + n_c * k_need / rho)
-    s_ = k_need * dt_**2 / rho
-    return ContactNumerics(dt_, s_, "contact", budget(dt_, s_),
-                           f"a contact stiff enough for a penetration below {PENETRATION[1]:g} h at "
-                           f"{PENETRATION[0]:.0e} Pa and stable with {n_c} contacts on a node needs a step of "
-                           f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}")
-
-
 def _time_step(case: Case, numerics: ContactNumerics, samples_per_frame: int):
     """``(dt, every, stroke time)``: the largest step up to ``numerics.dt_max`` filling each frame
     interval with a whole number of host chunks."""
@@ -541,7 +429,5 @@ def with_fabric(model, fabric):
     return model.replace(shell=model.shell.replace(fabrics=fabs))
 
 
-__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "ContactNumerics", "contact_numerics", "STEP_BUDGET", "auto_fibre_mass",
-           "FIBRE_MASS_MAX",
-           "STACKED_CONTACTS", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
+__all__ = ["PUNCH", "DIE", "HOLDER", "RunInfo", "HealthBounds", "health_bounds", "Rig", "build", "build_mesh", "grid_quads", "build_fabric",
            "ply_fabrics", "punch_motion", "stroke_time", "build_tools", "with_fabric"]

@@ -64,7 +64,7 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
 
 
 def _step_choice(info) -> dict:
-    """How the step and the contact stiffness were chosen (:func:`jaxform.forming.rig.contact_numerics`)."""
+    """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`)."""
     n = getattr(info, "numerics", None)
     if n is None:
         return {}

@@ -259,15 +259,19 @@ def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None,
 
 def advance(model: Model, state: State, n, *, e0: Energies | None = None, x_ref=None, blowup_tol: float = 0.5,
             energy_floor: float = 0.0) -> State:
-    """``n`` steps, ``n`` an integer that may be traced (a ``lax.fori_loop`` with a dynamic trip
-    count): one compiled program for any number of steps, so a driver's stretches of different
-    lengths (and runs of different strokes or frame counts on the same rig) share it. Forward only
-    (a while loop has no reverse mode): differentiate through :func:`run_steps`/:func:`rollout`.
-    A failed stretch returns its starting state with the failure recorded, as :func:`run_steps`.
+    """Up to ``n`` steps, ``n`` an integer that may be traced (a ``lax.while_loop``): one compiled
+    program for any number of steps, so a driver's stretches of different lengths (and runs of
+    different strokes or frame counts on the same rig) share it. Forward only (a while loop has no
+    reverse mode): differentiate through :func:`run_steps`/:func:`rollout`. A failed stretch
+    returns its starting state with the failure recorded, as :func:`run_steps`, and stops at the
+    failing step: the steps after a blow-up cost the most (non-finite or flying nodes rebuild the
+    contact tables every step), and a driver must hear of the failure at once.
     """
     x_ref = model.drive.position(0.0) if x_ref is None else x_ref
     e0 = state.energies if e0 is None else e0
-    end = jax.lax.fori_loop(0, n, lambda _, s: _advance(model, s, x_ref, e0, blowup_tol, energy_floor)[0], state)
+    stop = state.step + jnp.asarray(n, state.step.dtype)
+    end = jax.lax.while_loop(lambda s: (s.step < stop) & (s.bad_step < 0),
+                             lambda s: _advance(model, s, x_ref, e0, blowup_tol, energy_floor)[0], state)
     return _freeze_if_failed(state, end)
 
 

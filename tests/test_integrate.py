@@ -6,7 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform.integrate import SimulationError, init_state, make_model, rollout, simulate
+from jaxform.integrate import SimulationError, advance, init_state, make_model, rollout, simulate
 from jaxform.materials import WOVEN_38616
 from jaxform.mesh import Mesh
 from jaxform.shell import Shell, forces, stable_time_step
@@ -76,6 +76,11 @@ def test_too_large_time_step_warns_then_fails_with_step_time_and_frames():
     assert n_good < 50
     assert np.all(np.isfinite(np.asarray(err.frames.x)))
     assert n_good == int(err.step // 20)
+    # the host driver's stretch (a while loop) stops at the failing step and returns the last good state
+    end = jax.jit(advance, static_argnames=("blowup_tol",))(model, state, 1000, blowup_tol=0.5)
+    assert int(end.bad_step) == err.step and int(end.step) == err.step + 1
+    np.testing.assert_array_equal(np.asarray(end.x), np.asarray(state.x))
+    assert int(jax.jit(advance)(make_model(shell), state, 37).step) == 37  # a healthy stretch: all n steps
 
 
 def test_gravity_damping_and_fixed_nodes_settle_to_rest_with_balanced_energy():

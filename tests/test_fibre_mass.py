@@ -234,19 +234,34 @@ def test_rollout_with_fibre_mass_differentiates_like_finite_differences():
     assert g == pytest.approx(fd, rel=1e-5)
 
 
-@pytest.mark.parametrize("name, size_mm, factor", [("case-a-woven-nlbm", 2.0, 12.0), ("case-a-ncf-nlbm", 2.0, 6.0),
-                                                    ("case-a-woven-membrane", 4.0, 12.0)])
-def test_automatic_fibre_mass_stops_where_bending_sets_the_step(name, size_mm, factor):
-    """'auto': the smallest factor bringing the step within 25% of the bending limit, at most 12
-    (woven wants 23 at 2 mm; the NCF, 20x stiffer in bending, 5.8 -> 6; membrane only: the cap)."""
+STIFF_WOVEN = "fabric.voce={b_inf_Nm = 1.549e-3, m0_N = 0.757, kappa0_per_m = 20.0}"  # 100 x the woven's bending: 10 x omega_b
+
+
+@pytest.mark.parametrize("name, size_mm, factor, keys", [("case-a-woven-nlbm", 2.0, 12.0, ()),
+                                                          ("case-a-ncf-nlbm", 2.0, 3.0, ()),
+                                                          ("case-a-woven-membrane", 4.0, 12.0, ()),
+                                                          ("case-a-woven-nlbm", 2.0, 3.0, (STIFF_WOVEN,))])
+def test_automatic_fibre_mass_stops_where_bending_sets_the_step(name, size_mm, factor, keys):
+    """'auto': the smallest factor bringing the step within 25% of the bending limit, at most 12,
+    at most 3 for fibres off the blank's edges (woven wants 23 at 2 mm; the +-45 deg NCF 5.8, capped;
+    membrane only: the cap)."""
     from jaxform.forming import numerics, rig
     from jaxform.shell import stable_time_step
 
-    case = cases.with_element_size(cases.load(name), size_mm * 1e-3)
+    case = cases.apply_overrides(cases.with_element_size(cases.load(name), size_mm * 1e-3), list(keys))
     shell = Shell.build(rig.build_mesh(case), rig.ply_fabrics(case))
     s = numerics.auto_fibre_mass(shell)
     assert s == factor
-    if factor < numerics.FIBRE_MASS_MAX:  # within 25% of the bending-only step, and not more factor than that needs
+    if keys:  # not capped: within 25% of the bending-only step, and not more factor than that needs
         bending_only = stable_time_step(shell, safety=1.0, fibre_mass_factor=1e9)
         assert stable_time_step(shell, safety=1.0, fibre_mass_factor=s) >= bending_only / 1.25
         assert stable_time_step(shell, safety=1.0, fibre_mass_factor=s - 1) < bending_only / 1.25
+
+
+def test_automatic_fibre_mass_is_capped_where_the_fibres_run_off_the_blank_edges():
+    from jaxform.forming import numerics, rig
+
+    for orient, cap in (("[0.0]", 12.0), ("[45.0]", 3.0), ("[5.0]", 12.0), ("[20.0]", 3.0)):
+        case = cases.apply_overrides(cases.with_element_size(cases.load("case-a-woven-nlbm"), 4e-3),
+                                     [f"plies.orientations_deg={orient}"])
+        assert numerics.auto_fibre_mass(Shell.build(rig.build_mesh(case), rig.ply_fabrics(case))) == cap, orient

@@ -17,27 +17,43 @@ from jaxform.forming.case import Case
 from jaxform.shell import Shell, _ply_frequencies
 
 FIBRE_MASS_MAX = 12.0
-"""The largest automatic fibre-mass factor: the largest run to completion here (woven Case A,
-2 mm). Beyond the bending limit more is useless, and the position-dependent inverse mass can pump
-energy into a free corner that whips in-plane: NCF Case A at 2 mm with 12 blew up there at 79% of
-the stroke (a 3 m/s corner oscillation growing to 170 m/s in 150 steps) although the step was
-within the linear limit (omega dt / 2 = 0.24 at that state); with 6, or half the step, it did not."""
+"""The largest automatic fibre-mass factor for plies whose fibres run along the square blank's
+edges: the largest run to completion here (woven Case A at 2 mm, twice; beyond the bending limit
+more is useless anyway)."""
+FIBRE_MASS_MAX_OFF_AXIS = 3.0
+"""The largest automatic factor for plies whose fibres run off the blank's edges (more than 10
+degrees, e.g. the +-45 deg NCF). Their corners are held in-plane by shear alone and whip, and the
+position-dependent inverse mass (it follows the fibre directions without the term a varying mass
+adds to the momentum balance) pumps energy into them: measured on NCF Case A, 4 mm: 3 completes,
+6 and 12 blow up at 94% and 88% of the stroke; 2 mm: 6 completed, 12 blew up at 79% (a 3 m/s
+corner oscillation growing to 170 m/s in 150 steps, with the step within the linear limit,
+omega dt / 2 = 0.24 by power iteration on C K at that state; half the step, or no fibre mass, ran
+on). An empirical cap until that term is in."""
 FIBRE_MASS_RESERVE = 1.25
 """The automatic fibre-mass factor brings the step to within this factor of the bending limit."""
+
+
+def _along_edges(fabric, tol_deg: float = 10.0) -> bool:
+    """Both fibre families of ``fabric`` within ``tol_deg`` of the blank's x or y axis."""
+    return all(min(a % (0.5 * math.pi), 0.5 * math.pi - a % (0.5 * math.pi)) <= math.radians(tol_deg)
+               for a in (float(t) for t in fabric.fibre_angles))
 
 
 def auto_fibre_mass(shell: Shell, mass_scale=1.0) -> float:
     """``numerics.fibre_mass_scaling = "auto"``: the smallest factor ``s`` that brings the shell's
     stable step to within :data:`FIBRE_MASS_RESERVE` of its bending limit (``sqrt(omega_b^2 +
     (omega_m / s)^2) <= 1.25 omega_b``, i.e. ``s >= omega_m / (0.75 omega_b)``: more would buy
-    less than 25% of step), at most :data:`FIBRE_MASS_MAX`, rounded up to a whole number; 1 where
-    the membrane does not set the step (``omega_m / omega_b`` grows with the element size). Woven
-    Case A: 12 at 8, 4 and 2 mm (88, 45 and 23 wanted); NCF (20 x stiffer in bending): 12 at 8 and
-    4 mm (22, 12 wanted), 6 at 2 mm (5.8); membrane only: 12."""
-    need = 1.0
-    for wm, wb in _ply_frequencies(shell, mass_scale):
+    less than 25% of step), rounded up to a whole number, at most :data:`FIBRE_MASS_MAX`
+    (:data:`FIBRE_MASS_MAX_OFF_AXIS` when a ply's fibres run off the blank's edges); 1 where the
+    membrane does not set the step (``omega_m / omega_b`` grows with the element size). Woven
+    Case A: 12 at 8, 4 and 2 mm (88, 45 and 23 wanted); NCF (+-45 deg): 3 (22, 12 and 5.8 wanted
+    at 8, 4 and 2 mm); membrane only: 12."""
+    need, cap = 1.0, FIBRE_MASS_MAX
+    for (wm, wb), fab in zip(_ply_frequencies(shell, mass_scale), shell.fabrics):
         need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
-    return float(min(FIBRE_MASS_MAX, math.ceil(need)))
+        if not _along_edges(fab):
+            cap = min(cap, FIBRE_MASS_MAX_OFF_AXIS)
+    return float(min(cap, math.ceil(need)))
 
 
 STEP_BUDGET = 0.9
@@ -131,5 +147,5 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
                            f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}")
 
 
-__all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
+__all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
            "AUTO_SAFETY", "PENETRATION", "ContactNumerics", "contact_numerics"]

@@ -24,6 +24,10 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert "complete" in text and "frames.pvd" in text
     s = json.loads((tmp_out / "summary.json").read_text())
     assert s["complete"] is True and s["reason"] is None
+    # how the step was chosen, on screen and in the summary (forming.numerics)
+    n = s["numerics"]
+    assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
+    assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
     for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s"):
         assert isinstance(s[key], float) and np.isfinite(s[key])
     assert s["inputs"]["blank"]["element_size_mm"] == 25.0 and s["inputs"]["process"]["stroke_mm"] == 4.0

@@ -194,6 +194,13 @@ def report(result, written, out, stream=None):
             print(f"  warning: not quasi-static by its own numbers: the kinetic energy reached {s['max_ke_ie']:.3g} x "
                   f"the internal energy over the last 80% of the stroke (quasi-static: below {QUASI_STATIC_KE_IE:g}); "
                   "inertia shapes this result. Lower process.speed_mm_per_s.", file=stream)
+    n = s.get("numerics") or {}
+    if n.get("dt_governed_by"):
+        fm = n.get("fibre_mass_scaling", 1.0)
+        safety = "from the given stiffness" if n.get("contact_safety") is None else f"{n['contact_safety']:.3g}"
+        mass = "off" if fm == 1.0 else f"x{fm:g}" + (" (auto)" if n.get("fibre_mass_choice") == "auto" else "")
+        print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
+              f"{safety}, fibre mass {mass}", file=stream)
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)

@@ -2,6 +2,7 @@
 gradients of a short run against finite differences."""
 import dataclasses
 import math
+import warnings
 
 import jax
 import jax.numpy as jnp
@@ -177,5 +178,12 @@ def _areal_mass(case):
 
 def test_a_given_contact_safety_that_breaks_the_step_budget_is_warned_about():
     case = _coarse("case-a-woven-nlbm", process__frames=2, contact__safety=0.9)
-    with pytest.warns(RuntimeWarning, match="four|4 contacts"):
-        forming.build(case)
+    with pytest.warns(RuntimeWarning, match="4 contacts unstable") as record:
+        info = forming.build(case).info
+    assert info.numerics.budget > 1.0 and info.numerics.safety == 0.9  # the given safety is kept, not replaced
+    assert f"{info.numerics.budget:.2f} > 1" in str(record[0].message)
+    # the automatic choice stays within the budget on the same case, and says nothing
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        auto = forming.build(_coarse("case-a-woven-nlbm", process__frames=2)).info.numerics
+    assert auto.budget <= 0.9 + 1e-9

@@ -31,6 +31,8 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
+from jaxform.batching import any_member
+
 __all__ = ["nearest_centroids", "cell_size", "grid_keys", "cell_ranges", "candidates", "moved_beyond", "SearchState", "initial_search_state",
            "initial_state_of", "refreshed"]
 
@@ -208,6 +210,7 @@ def refreshed(state: SearchState, x, search, half_skin, every: int) -> SearchSta
     """``state`` advanced by one call: the table rebuilt (``lax.cond``) when some node moved more
     than ``half_skin`` (m) since the last refresh, or ``every`` calls have passed."""
     due = moved_beyond(x, state.x_ref, half_skin) | (state.step - state.last >= every)
+    due = any_member(due)  # in a batch of runs: one search for all, a branch rather than both (jaxform.batching)
 
     def fresh():
         return SearchState(search(x), state.step, x, state.step, state.refreshes + 1)

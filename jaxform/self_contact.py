@@ -42,6 +42,7 @@ import numpy as np
 
 from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
+from jaxform.batching import any_member
 from jaxform.contact import ContactResult, node_contact, ply_contact
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
                               safe_normalize, segments_sqdist)
@@ -305,7 +306,8 @@ class SelfContactLoad:
                 "max_pressure": jnp.maximum(jnp.max(res.pressure * wn), jnp.max(ee.pressure * we)),
                 "min_gap": jnp.min(jnp.where(wn, res.gap, inf)), "min_edge_gap": jnp.min(jnp.where(we, ee.gap, inf))}
 
-        f, extras = jax.lax.cond(c.overflow, lambda: part(self.slave, jnp.arange(self.edges.shape[0])),
+        # in a batch of runs every member evaluates all when one overflows (jaxform.batching)
+        f, extras = jax.lax.cond(any_member(c.overflow), lambda: part(self.slave, jnp.arange(self.edges.shape[0])),
                                  lambda: part(c.active_nodes, c.active_edges))
         extras.update(refreshes=st.refreshes, active_overflow=c.overflow.astype(jnp.int32))
         return f, st, extras

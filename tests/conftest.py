@@ -30,6 +30,9 @@ import jax  # noqa: E402
 import pytest  # noqa: E402
 
 jax.config.update("jax_enable_x64", True)
+# two CPU devices, so that batched runs are sharded over devices in the tests as on a real machine
+# (jaxform.forming.batch); everything else runs on the first, as it would without this
+jax.config.update("jax_num_cpu_devices", 2)
 
 
 def rtol_for(dtype) -> float:

@@ -111,13 +111,14 @@ def execute(case, out, *, force=False, quiet=False, stream=None, element_size=No
     result.summary["wall_time_s"] = result.wall_time_s
     written = [writer.pvd_path] if len(result.t) else []
     if len(result.t) >= 1:
-        written += _plots(result, out)
+        written += save_plots(result, out)
     write_json(summary_path, result.summary)
     written.insert(0, summary_path)
     return result, written
 
 
-def _plots(result, out):
+def save_plots(result, out):
+    """The run's PNG plots in ``out`` (shear map, deviation map, punch force); returns their paths."""
     from jaxform.plots import forming as fplots
     from jaxform.plots.fields import save
 

@@ -110,7 +110,7 @@ def _single_frame(s):
                             ok=jnp.zeros((1,), bool))
 
 
-class _Recorder:
+class Recorder:
     """Host-side frames and sampled histories of a run."""
 
     def __init__(self, on_frame):
@@ -137,12 +137,13 @@ class _Recorder:
             self.on_frame(k, float(s.t), self.x[-1], host)
 
 
-def _check_health(state, fl, info: RunInfo, last_good) -> None:
-    """Raise :class:`~jaxform.integrate.SimulationError` when the run left the physical bounds of
-    ``info.bounds`` (a run can blow up without a NaN or an energy-balance jump: nodes flung away
-    by an over-damped contact still balance their energy)."""
-    b = info.bounds
-    x = np.asarray(state.x)
+def physical_causes(x, fl, bounds) -> list[str]:
+    """Host: how a state (positions ``x`` (N, 3) m, its fields ``fl``) left the physical bounds of
+    a run (:class:`~jaxform.forming.rig.HealthBounds`), in words; empty when it did not. A run can
+    blow up without a NaN or an energy-balance jump: nodes flung away by an over-damped contact
+    still balance their energy."""
+    b = bounds
+    x = np.asarray(x)
     strain, speed = float(fl["max_fibre_strain"]), float(fl["max_node_speed"])
     causes = []
     if not strain <= b.fibre_strain:
@@ -153,14 +154,26 @@ def _check_health(state, fl, info: RunInfo, last_good) -> None:
     if not (np.all(lo >= np.asarray(b.box_lo)) and np.all(hi <= np.asarray(b.box_hi))):
         far = max(float(np.max(np.asarray(b.box_lo) - lo)), float(np.max(hi - np.asarray(b.box_hi))))
         causes.append(f"the part left the rig (nodes {far * 1e3:.3g} mm outside the box of twice the blank)")
+    return causes
+
+
+def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
+    """The words of a run that left its physical bounds (:func:`physical_causes`)."""
+    return (f"the run left its physical bounds near step {step} (t = {t:.6e} s, punch {punch_m * 1e3:.2f} "
+            f"mm): {'; '.join(causes)}. Likely cause: an unstable or badly set-up run (time step, contact stiffness or "
+            "damping, mass scaling); the frames up to the last good one are kept.")
+
+
+def _check_health(state, fl, info: RunInfo, last_good) -> None:
+    """Raise :class:`~jaxform.integrate.SimulationError` when the run left the physical bounds of
+    ``info.bounds`` (:func:`physical_causes`)."""
+    causes = physical_causes(state.x, fl, info.bounds)
     if not causes:
         return
     step, t = int(state.step), float(state.t)
-    raise integrate.SimulationError(
-        f"the run left its physical bounds near step {step} (t = {t:.6e} s, punch {float(fl['punch_displacement']) * 1e3:.2f} "
-        f"mm): {'; '.join(causes)}. Likely cause: an unstable or badly set-up run (time step, contact stiffness or "
-        "damping, mass scaling); the frames up to the last good one are kept.",
-        step=step, time=t, cause="; ".join(causes), frames=_single_frame(last_good), state=last_good)
+    raise integrate.SimulationError(out_of_bounds_message(step, t, float(fl["punch_displacement"]), causes),
+                                    step=step, time=t, cause="; ".join(causes), frames=_single_frame(last_good),
+                                    state=last_good)
 
 
 def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False,
@@ -185,7 +198,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     e0, x_ref = state.energies, state.x
     floor = jnp.asarray(_floor(state), state.x.dtype)
     n_sub = jnp.asarray(info.sub_steps, jnp.int32)
-    rec = _Recorder(on_frame)
+    rec = Recorder(on_frame)
     complete, reason = False, None
     try:
         fl = fields_jit(model, state, ply_arr, n_plies=n_plies)
@@ -266,4 +279,5 @@ def simulate(case: Case, *, dtype=None, element_size: float | None = None, overr
     return result
 
 
-__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "run", "simulate"]
+__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "run", "simulate", "physical_causes",
+           "out_of_bounds_message"]

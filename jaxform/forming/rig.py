@@ -353,7 +353,7 @@ MIN_SAMPLES = 200
 
 
 def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float = 0.75,
-          samples_per_frame: int | None = None, fabric=None, damping: float = 0.0) -> Rig:
+          samples_per_frame: int | None = None, fabric=None, damping: float = 0.0, every: int | None = None) -> Rig:
     """Build a forming run once: mesh, fabrics, shell, tools, contact loads, time step, initial state.
 
     Args:
@@ -366,6 +366,10 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
             at least 10 and enough for :data:`MIN_SAMPLES` samples over the stroke).
         fabric: a :class:`~jaxform.materials.Fabric` replacing the case's (e.g. custom laws).
         damping: mass-proportional damping, 1/s (default none).
+        every: steps per frame interval, at least the chosen step's and a multiple of
+            ``samples_per_frame``: the step shortened to share a step count with other runs (a
+            batch, :func:`jaxform.forming.batch.simulate_batch`); the contact stiffness stays that
+            of the step chosen, so only the step differs from the run built without it.
 
     Returns:
         :class:`Rig` ``(model, state, info)``.
@@ -398,8 +402,19 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
                       f"{STACKED_CONTACTS} contacts unstable (omega dt / 2 = {numerics.budget:.2f} > 1); folds pressed "
                       "under the holder may blow up. Use contact.safety = 'auto' or a smaller step.", RuntimeWarning,
                       stacklevel=2)
-    dt, every, T = _time_step(case, numerics, samples_per_frame)
-    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, numerics.safety)
+    dt, every_own, T = _time_step(case, numerics, samples_per_frame)
+    safety = numerics.safety
+    if every is not None and int(every) != every_own:
+        if int(every) < every_own or int(every) % samples_per_frame:
+            raise ValueError(f"forming.build: every = {every}: need a multiple of samples_per_frame "
+                             f"({samples_per_frame}) of at least {every_own} (the step chosen for this case)")
+        dt_own, dt = dt, T / (n_int * int(every))
+        if safety is not None:  # the same stiffness k = safety rho / dt^2 at the shorter step
+            safety = safety * (dt / dt_own) ** 2
+        numerics = dataclasses.replace(numerics, why=f"{numerics.why}; the step shortened from {dt_own:.3g} s to "
+                                                    f"{dt:.3g} s to share {every} steps per frame with a batch")
+    every = every_own if every is None else int(every)
+    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, safety)
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
                                  fibre_mass_factor=fms)

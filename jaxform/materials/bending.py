@@ -19,6 +19,7 @@ import dataclasses
 from typing import Any
 
 import jax.numpy as jnp
+import numpy as np
 
 from jaxform import validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
@@ -97,7 +98,7 @@ class VoceBending:
             validate.nonnegative("VoceBending", "m0", self.m0, "N")
             validate.positive("VoceBending", "kappa0", self.kappa0, "1/m")
             b_init = self.b_inf + self.m0 / self.kappa0
-            if jnp.any(jnp.asarray(b_init) <= 0):
+            if np.any(np.asarray(b_init) <= 0):  # numpy: concrete values, and no JAX backend started on import
                 raise ValueError(
                     f"VoceBending: b_inf + m0/kappa0 = {b_init!r} N·m: the law has no stiffness; "
                     "at least one of b_inf, m0 must be > 0"

@@ -15,7 +15,8 @@ Modules along the data flow (imports point one way along it)::
     cantilever, frame_tests   lab tests built on the same shell (cantilever, picture frame, bias extension)
     calibrate                 fitting laws to measurements through the model
 
-``jaxform.simulate(case)`` runs a forming case (a ``Case``, a preset name or a ``.toml`` path).
+``jaxform.simulate(case)`` runs a forming case (a ``Case``, a preset name or a ``.toml`` path);
+``jaxform.simulate_batch(case, overrides_per_member)`` runs many variants of it as batched programs.
 Sub-modules are imported on first use, so ``import jaxform`` stays light.
 """
 from __future__ import annotations
@@ -48,13 +49,13 @@ _MODULES = (
 def __getattr__(name: str):
     if name in _MODULES:
         return importlib.import_module(f"jaxform.{name}")
-    if name == "simulate":
-        return importlib.import_module("jaxform.cases").simulate
+    if name in ("simulate", "simulate_batch"):
+        return getattr(importlib.import_module("jaxform.cases"), name)
     raise AttributeError(f"module 'jaxform' has no attribute {name!r}")
 
 
 def __dir__():
-    return sorted(list(globals()) + list(_MODULES) + ["simulate"])
+    return sorted(list(globals()) + list(_MODULES) + ["simulate", "simulate_batch"])
 
 
-__all__ = ["materials", "units", "Fabric", "WOVEN_38616", "NCF_FCIM359", "simulate", "__version__", *_MODULES]
+__all__ = ["materials", "units", "Fabric", "WOVEN_38616", "NCF_FCIM359", "simulate", "simulate_batch", "__version__", *_MODULES]

@@ -43,6 +43,16 @@ def simulate(case, *, element_size: float | None = None, overrides=(), **kwargs)
     return _simulate(resolve(case, element_size=element_size, overrides=overrides), **kwargs)
 
 
+def simulate_batch(case, overrides_per_member, *, element_size: float | None = None, overrides=(), **kwargs):
+    """Run a forming case (a :class:`Case`, a preset name or a ``.toml`` path, with ``overrides``
+    for all) once per member, ``overrides_per_member`` a list of ``["section.key=value", ...]``:
+    :func:`jaxform.forming.batch.simulate_batch` with the other keyword arguments (members that
+    share a mesh run as one vmapped program over the devices). One result per member."""
+    from jaxform.forming.batch import simulate_batch as _batch
+
+    return _batch(resolve(case, element_size=element_size, overrides=overrides), overrides_per_member, **kwargs)
+
+
 __all__ = ["Case", "FabricSpec", "ToolSpec", "HolderSpec", "ProcessSpec", "ContactSpec", "BENDING_MODELS", "PRESETS",
            "list_presets", "preset", "load", "loads", "resolve", "from_dict", "to_dict", "to_toml", "apply_overrides",
-           "with_element_size", "ply_heights", "simulate"]
+           "with_element_size", "ply_heights", "simulate", "simulate_batch"]

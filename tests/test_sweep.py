@@ -135,3 +135,15 @@ def test_two_processes_share_a_sweep_and_process_0_gathers_the_table(swept, tmp_
         assert float(r2["max_shear_angle_deg"]) == pytest.approx(float(r1["max_shear_angle_deg"]), abs=0.01)
         assert float(r2["draw_in_edge_mid_mm"]) == pytest.approx(float(r1["draw_in_edge_mid_mm"]), rel=1e-3)
         assert (out / r2["dir"] / "frames.pvd").is_file()
+
+
+def test_sweep_refuses_bad_input_before_it_writes_anything(tmp_path, capsys):
+    out = tmp_path / "bad"
+    for vary, why in [("fabric.nope=1,2", "fabric.nope"), ("fabric.friction_tool=0.2,-1", "friction"),
+                      ("fabric.friction_tool", "KEY=V1,V2")]:
+        assert main(["sweep", "case-a-woven-nlbm", "--vary", vary, "--out", str(out), "--quiet"]) == 2
+        assert why in capsys.readouterr().err
+    assert not out.exists()
+    assert main(["sweep", "case-a-woven-nlbm", "--vary", "fabric.friction_tool=0.2", "--out", str(out),
+                 "--coordinator", "127.0.0.1:1", "--quiet"]) == 2
+    assert "--num-processes" in capsys.readouterr().err and not out.exists()

@@ -267,6 +267,9 @@ def run(args) -> int:
                        on_progress=on_progress)
     if current[0] is not None:
         progress.done()
+    for i in mine:  # members of parts never started: an earlier part was interrupted
+        rows.setdefault(i, {"member": i, "dir": names[i], **dict(zip((k for k, _ in vary), combos[i])),
+                            "complete": False, "reason": "not run: the sweep was interrupted", "process": pid})
     every = _gather_rows(rows, len(combos)) if n_proc > 1 else [rows[i] for i in range(len(combos))]
     if pid == 0:
         from jaxform.plots.sweep import sweep_plots
@@ -277,4 +280,12 @@ def run(args) -> int:
             print(f"{len(every)} members, {failed} failed. Wrote to {out.resolve()}:")
             for p in written:
                 print(f"  {p}")
-    return 0 if all(r["complete"] for r in every) else 1
+    if all(r["complete"] for r in every):
+        return 0
+    from jaxform.cli import TERMINATED
+    from jaxform.forming.batch import INTERRUPTED
+
+    reasons = [r.get("reason") or "" for r in every]
+    if any(TERMINATED in r for r in reasons):
+        return 143
+    return 130 if any(r.startswith(INTERRUPTED) for r in reasons) else 1

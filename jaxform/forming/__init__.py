@@ -8,6 +8,7 @@ Modules, along the data flow (imports point one way):
     fields    nodal fields of a state (pure, jit-able)
     summary   draw-in, wrinkle count, symmetry, the JSON summary, the half-speed check (host, numpy)
     driver    pure chunks and rollout; the host run with frames and progress callbacks
+    batch     many members of a case as vmapped programs sharded over devices (sweeps)
 
 ``simulate(case)`` = ``run(build(jaxform.cases.resolve(case)))``.
 """

@@ -60,6 +60,8 @@ from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, build
 from jaxform.forming.summary import summarize
 
+INTERRUPTED = "interrupted (KeyboardInterrupt)"
+"""The start of the reason of members stopped by Ctrl-C or SIGTERM (their batch runs no further part)."""
 MESH_AXIS = "batch"
 """The axis of the device mesh the members are sharded over (one member axis, vmapped within a
 device as :data:`jaxform.batching.BATCH_AXIS`)."""
@@ -360,7 +362,7 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                 break
     except KeyboardInterrupt as err:
         for i in np.flatnonzero(active[:B]):
-            reasons[i] = str(err) or "interrupted by the user (KeyboardInterrupt)"
+            reasons[i] = INTERRUPTED + (f": {err}" if str(err) else "")
             last_good[i] = _member(state, all_axes, i)
     wall = time.perf_counter() - t_wall
     results = []
@@ -398,7 +400,8 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
         on_part: ``on_part(part: BatchPart, results)`` after each part (e.g. to write its outputs).
 
     Returns:
-        one :class:`~jaxform.forming.driver.FormingResult` per member, in order; each
+        one :class:`~jaxform.forming.driver.FormingResult` per member, in order (``None`` for the
+        members of parts never started because an earlier part was interrupted); each
         ``summary["batch"]`` says which group and part ran it, with how many members and devices.
         Each ``wall_time_s`` is its part's (build and run), shared by the part's members.
     """
@@ -426,8 +429,10 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
             results[i] = res
         if on_part is not None:
             on_part(part, out)
+        if any((r.reason or "").startswith(INTERRUPTED) for r in out):
+            break
     return results
 
 
-__all__ = ["MESH_AXIS", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "member_bytes", "plan_parts",
+__all__ = ["INTERRUPTED", "MESH_AXIS", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "member_bytes", "plan_parts",
            "run_part", "simulate_batch"]

@@ -13,7 +13,8 @@ Central differences (velocities at half steps), the free dofs carrying the momen
     u_{n+1} = u_n + dt v_{n+½},   x_{n+1} = X + u_{n+1}
 
 ``C`` is the inverse mass: ``M^-1`` (lumped), or with a fibre mass (:mod:`jaxform.fibre_mass`)
-the polynomial ``C(x_n)``. The integrated quantity is the displacement ``u`` from the mesh nodes
+the polynomial ``C(x_n)``, whose dependence on the positions adds ``-1/2 d(p_{n-½}^T C p_{n-½})/dx``
+to ``f_n`` (Hamilton's equations for a position-dependent mass). The integrated quantity is the displacement ``u`` from the mesh nodes
 ``X`` and the shell is evaluated on it (float32 absolute positions would add rounding noise to
 every strain).
 
@@ -83,7 +84,7 @@ class Frames:
 
 def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, mass_scale: float = 1.0,
                damping: float = 0.0, gravity=(0.0, 0.0, 0.0), fixed=None, drive=None, loads: tuple = (),
-               dtype=None, fibre_mass_factor: float = 1.0) -> Model:
+               dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_momentum_term: bool = False) -> Model:
     """Build a :class:`Model` on the host.
 
     ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.shell.stable_time_step`);
@@ -92,11 +93,14 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
     fibre stretching only (:mod:`jaxform.fibre_mass`; the membrane limit grows by ``s``). ``fixed``
     (N, 3) bool marks driven dofs (default none), ``drive`` gives their positions (default: held
     where they are); with a fibre mass, the added inertia couples free dofs only (a driven dof's
-    motion does not load its free neighbours through it).
+    motion does not load its free neighbours through it); ``fibre_mass_momentum_term`` adds the
+    term the position-dependent fibre mass puts into the momentum equation
+    (:func:`jaxform.fibre_mass.geometric_force`).
     """
     dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
     # first: it checks the factor (a clear error before any use of it)
-    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, dtype=dtype)
+    fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, dtype=dtype,
+                        momentum_term=fibre_mass_momentum_term)
     dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
     if dt is None:
         dt = safety * dt_limit
@@ -163,11 +167,13 @@ def _step(model: Model, state: State, x_ref):
         new_loads.append(ls_new)
         extras.append(ex)
     f_free = f_int + f_grav + f_damp + f_loads
-    # on the first step the initial velocity is the full-step velocity: advance half a step
-    h = jnp.where(first, 0.5 * dt, dt)
     fixed = model.fixed.T
     fm = model.fibre_mass
     free = jnp.where(fixed, 0.0, 1.0).astype(xs.dtype)
+    if fm is not None and fm.geometric:  # the position-dependent mass's own term (Hamilton)
+        f_free = f_free + _fm.geometric_force(xs, state.momentum, model.mass, free, fm, model.shell)
+    # on the first step the initial velocity is the full-step velocity: advance half a step
+    h = jnp.where(first, 0.5 * dt, dt)
     p_new = free * (state.momentum + h * f_free)
     if fm is None:
         v_free = p_new / m

@@ -26,7 +26,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                damping_ratio, optional self_contact (default true: folds lie on themselves)
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto" or >= 1,
                default 1 = off: inertia added to fibre stretching only, the membrane limit of
-               the step grows by that factor; see jaxform.fibre_mass)
+               the step grows by that factor; see jaxform.fibre_mass), optional
+               fibre_mass_momentum_term (default false: the exact term of a position-dependent mass)
 
 No I/O and no physics here: TOML text is parsed and written by :mod:`jaxform.io.case_file`, the
 presets live in :mod:`jaxform.forming.presets`, and the rig is built by :mod:`jaxform.forming.rig`.
@@ -133,6 +134,7 @@ class Case:
     dtype: str
     mass_scaling: float
     fibre_mass_scaling: float | None = 1.0  # None: automatic (jaxform.forming.numerics.auto_fibre_mass)
+    fibre_mass_momentum_term: bool = False  # jaxform.fibre_mass.geometric_force
 
     @property
     def n_plies(self) -> int:
@@ -180,7 +182,8 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
                 "self_contact": ("bool", False)},
-    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False)},
+    "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False),
+                 "fibre_mass_momentum_term": ("bool", False)},
 }
 _VOCE_KEYS = ("b_inf_Nm", "m0_N", "kappa0_per_m")
 
@@ -376,6 +379,7 @@ def _build(d) -> Case:
         blank_size=d["blank"]["size_mm"] * _MM, element_size=d["blank"]["element_size_mm"] * _MM,
         tools=tools_spec, holder=holder, process=process, contact=contact_spec,
         dtype=n["dtype"], mass_scaling=n["mass_scaling"], fibre_mass_scaling=None if fms == "auto" else fms,
+        fibre_mass_momentum_term=n.get("fibre_mass_momentum_term", False),
     )
     _check_setup(case)
     return case
@@ -484,7 +488,8 @@ def to_dict(case: Case) -> dict:
         holder["mass_kg"] = h.mass
     p, c = case.process, case.contact
     numerics = {"dtype": case.dtype, "mass_scaling": case.mass_scaling,
-                "fibre_mass_scaling": "auto" if case.fibre_mass_scaling is None else case.fibre_mass_scaling}
+                "fibre_mass_scaling": "auto" if case.fibre_mass_scaling is None else case.fibre_mass_scaling,
+                "fibre_mass_momentum_term": case.fibre_mass_momentum_term}
     return {
         "name": case.name,
         "description": case.description,

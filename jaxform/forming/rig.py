@@ -394,7 +394,8 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     fabrics = ply_fabrics(case, fabric)
     shell = Shell.build(mesh, fabrics)
     ms = float(case.mass_scaling)
-    fms = auto_fibre_mass(shell, ms) if case.fibre_mass_scaling is None else float(case.fibre_mass_scaling)
+    fms = (auto_fibre_mass(shell, ms, momentum_term=case.fibre_mass_momentum_term) if case.fibre_mass_scaling is None
+           else float(case.fibre_mass_scaling))
     stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
     numerics = contact_numerics(case, fabrics, stable, dt, dt_safety)
     if numerics.budget > 1.0:
@@ -417,7 +418,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, safety)
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
-                                 fibre_mass_factor=fms)
+                                 fibre_mass_factor=fms, fibre_mass_momentum_term=case.fibre_mass_momentum_term)
     x0 = jnp.asarray(mesh.nodes, jdtype)
     # jitted: eager (op-by-op) evaluation of the shell forces and of the contact searches costs
     # seconds to minutes (each operation compiled on its own)

@@ -199,7 +199,8 @@ def report(result, written, out, stream=None):
     if n.get("dt_governed_by"):
         fm = n.get("fibre_mass_scaling", 1.0)
         safety = "from the given stiffness" if n.get("contact_safety") is None else f"{n['contact_safety']:.3g}"
-        mass = "off" if fm == 1.0 else f"x{fm:g}" + (" (auto)" if n.get("fibre_mass_choice") == "auto" else "")
+        mass = "off" if fm == 1.0 else f"x{fm:g}" + (" (auto)" if n.get("fibre_mass_choice") == "auto" else "") + (
+            " with its momentum term" if n.get("fibre_mass_momentum_term") else "")
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
               f"{safety}, fibre mass {mass}", file=stream)
     if "quasi_static_check" in s:

@@ -110,6 +110,7 @@ def summarize(result) -> dict:
                      "nodes": int(len(info.x0)), "mass_scaling": float(case.mass_scaling),
                      "fibre_mass_scaling": float(getattr(info, "fibre_mass_factor", case.fibre_mass_scaling or 1.0)),
                      "fibre_mass_choice": "auto" if case.fibre_mass_scaling is None else "given",
+                     "fibre_mass_momentum_term": bool(getattr(case, "fibre_mass_momentum_term", False)),
                      # products with the fibre-tension stiffness per step: degree - 1
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,

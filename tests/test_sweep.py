@@ -21,7 +21,7 @@ from jaxform.forming import batch
 pytestmark = pytest.mark.filterwarnings("ignore:forming.build. the time step and contact stiffness:RuntimeWarning")
 
 BASE = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3"]
-VARY = ["--vary", "fabric.friction_tool=0.2,0.3", "--vary", "contact.penalty_stiffness_Pa_per_m=auto,1e13"]
+VARY = ["--vary", "fabric.friction_tool=0.2,0.3", "--vary", "contact.penalty_stiffness_Pa_per_m=auto,1e13,1e3"]
 
 
 def _case(*overrides):
@@ -36,8 +36,9 @@ def _rows(path):
 
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
-    """One sweep of 4 members (friction x contact stiffness; the 1e13 Pa/m members blow up),
-    in this process, sharded over the two CPU devices of the test session."""
+    """One sweep of 6 members (friction x contact stiffness; the 1e13 Pa/m members blow up, the
+    1e3 Pa/m ones cannot be built), in this process, the 4 that run sharded over the two CPU
+    devices of the test session."""
     out = tmp_path_factory.mktemp("sweep") / "out"
     code = main(["sweep", "case-a-woven-nlbm", *BASE, *VARY, "--out", str(out), "--quiet"])
     return code, out, _rows(out / "sweep.csv")
@@ -84,10 +85,15 @@ def test_members_share_a_step_count_and_split_into_groups_and_parts():
 
 def test_sweep_writes_each_member_like_a_run_and_a_table(swept):
     code, out, rows = swept
-    assert code == 1  # two members failed: the command says so
-    assert [r["fabric.friction_tool"] for r in rows] == ["0.2", "0.2", "0.3", "0.3"]
-    assert [r["complete"] for r in rows] == ["True", "False", "True", "False"]
-    for r in rows:
+    assert code == 1  # members failed: the command says so
+    assert [r["fabric.friction_tool"] for r in rows] == ["0.2"] * 3 + ["0.3"] * 3
+    assert [r["complete"] for r in rows] == ["True", "False", "False"] * 2
+    for r in rows[2::3]:  # no rig: reported, with no frames and nothing that looks like a result
+        s = json.loads((out / r["dir"] / "summary.json").read_text())
+        assert r["reason"].startswith("error before the run started: contact_params") and s["reason"] == r["reason"]
+        assert not s["complete"] and s["max_shear_angle_deg"] is None and r["max_shear_angle_deg"] == ""
+        assert not list((out / r["dir"]).glob("frames_*.vtu"))
+    for r in rows[0::3] + rows[1::3]:
         d = out / r["dir"]
         s = json.loads((d / "summary.json").read_text())
         assert s["batch"]["members"] == 4 and s["batch"]["devices"] == 2
@@ -104,7 +110,7 @@ def test_sweep_writes_each_member_like_a_run_and_a_table(swept):
 def test_a_member_equals_its_single_run(swept):
     _, out, rows = swept
     single = forming.simulate(_case("fabric.friction_tool=0.3"))
-    row = rows[2]
+    row = rows[3]
     assert float(row["max_shear_angle_deg"]) == pytest.approx(single.summary["max_shear_angle_deg"], abs=0.01)
     assert float(row["draw_in_edge_mid_mm"]) == pytest.approx(1e3 * single.summary["draw_in"]["edge_mid_m"], rel=1e-3)
     last = sorted((out / row["dir"]).glob("frames_*.vtu"))[-1]
@@ -131,7 +137,7 @@ def test_two_processes_share_a_sweep_and_process_0_gathers_the_table(swept, tmp_
     assert [p.returncode for p in procs] == [0, 0], logs
     two = _rows(out / "sweep.csv")
     assert [r["process"] for r in two] == ["0", "1"] and all(r["complete"] == "True" for r in two)
-    for r2, r1 in zip(two, (rows[0], rows[2])):  # the same members as the in-process sweep's
+    for r2, r1 in zip(two, (rows[0], rows[3])):  # the same members as the in-process sweep's
         assert float(r2["max_shear_angle_deg"]) == pytest.approx(float(r1["max_shear_angle_deg"]), abs=0.01)
         assert float(r2["draw_in_edge_mid_mm"]) == pytest.approx(float(r1["draw_in_edge_mid_mm"]), rel=1e-3)
         assert (out / r2["dir"] / "frames.pvd").is_file()

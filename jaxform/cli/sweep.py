@@ -187,7 +187,8 @@ def _cpu_devices(n):
     """One JAX CPU device per core (before JAX starts; once it has, its devices stay as they are)."""
     import jax
 
-    n = len(os.sched_getaffinity(0)) if n is None and hasattr(os, "sched_getaffinity") else (n or os.cpu_count())
+    if n is None:
+        n = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
     if int(n) < 1:
         raise ValueError(f"--cpu-devices {n}: need at least 1")
     try:
@@ -262,14 +263,18 @@ def run(args) -> int:
 
     if not args.quiet:
         print(f"sweep of {base.name}: {len(combos)} members, {len(mine)} in process {pid} of {n_proc}", flush=True)
+    results = []
     if mine:
-        simulate_batch(base, [overrides[i] for i in mine], on_frame=on_frame, on_part=on_part,
-                       on_progress=on_progress)
+        results = simulate_batch(base, [overrides[i] for i in mine], on_frame=on_frame, on_part=on_part,
+                                 on_progress=on_progress)
     if current[0] is not None:
         progress.done()
-    for i in mine:  # members of parts never started: an earlier part was interrupted
-        rows.setdefault(i, {"member": i, "dir": names[i], **dict(zip((k for k, _ in vary), combos[i])),
-                            "complete": False, "reason": "not run: the sweep was interrupted", "process": pid})
+    for i, res in zip(mine, results):  # members that never ran (no rig, or an interrupted sweep): say why
+        if i not in rows:
+            write_json(dirs[i] / "summary.json", res.summary)
+            rows[i] = _row(i, names[i], vary, combos[i], res, pid)
+            if not args.quiet:
+                print(f"  {names[i]}: NOT RUN ({res.reason})", flush=True)
     every = _gather_rows(rows, len(combos)) if n_proc > 1 else [rows[i] for i in range(len(combos))]
     if pid == 0:
         from jaxform.plots.sweep import sweep_plots

@@ -52,7 +52,7 @@ from jax.sharding import PartitionSpec as P
 
 from jaxform import integrate
 from jaxform.batching import BATCH_AXIS
-from jaxform.forming.case import Case
+from jaxform.forming.case import Case, to_dict
 from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, _floor, out_of_bounds_message,
                                     physical_causes)
 from jaxform.forming.fields import SCALARS, state_fields
@@ -65,6 +65,10 @@ INTERRUPTED = "interrupted (KeyboardInterrupt)"
 MESH_AXIS = "batch"
 """The axis of the device mesh the members are sharded over (one member axis, vmapped within a
 device as :data:`jaxform.batching.BATCH_AXIS`)."""
+MEMORY_PER_ARRAY_BYTE = 20.0
+"""Bytes a batch program needs per byte of a member's model and state arrays: measured 15 (the
+compiled program's memory analysis, arguments, outputs and temporaries, two members of woven
+Case A: 31 MB at 8 mm for 2 x 1.04 MB of arrays, 115 MB at 4 mm for 2 x 3.83 MB), 20 with a margin."""
 MEMORY_FRACTION = 0.6
 """Share of the devices' free memory a batch program may plan to use (the rest: JAX, the host's
 frames, other programs)."""
@@ -112,13 +116,23 @@ def signature(rig: Rig):
     return tree, shapes, info.n_frames, info.samples_per_frame
 
 
-def build_members(cases: Sequence[Case], *, dtype=None, samples_per_frame: int | None = None):
+def build_members(cases: Sequence[Case], *, dtype=None, samples_per_frame: int | None = None, catch: bool = False):
     """The members' rigs and their structure groups: ``(rigs, groups)``, ``groups`` a list of
     member-index lists. Within a group the steps per frame are made equal (the largest; see the
-    module docstring), so each group can run as one program."""
-    rigs = [build(c, dtype=dtype, samples_per_frame=samples_per_frame) for c in cases]
+    module docstring), so each group can run as one program. ``catch``: a member whose rig cannot
+    be built gets its exception in place of the rig and no group (the others are built)."""
+    rigs = []
+    for c in cases:
+        try:
+            rigs.append(build(c, dtype=dtype, samples_per_frame=samples_per_frame))
+        except (ValueError, TypeError) as err:  # the set-up checks of the rig (contact, mass...)
+            if not catch:
+                raise
+            rigs.append(err)
     keys, groups = [], []
     for i, r in enumerate(rigs):
+        if isinstance(r, Exception):
+            continue
         sig = signature(r)
         for k, key in enumerate(keys):
             if key == sig:
@@ -133,6 +147,17 @@ def build_members(cases: Sequence[Case], *, dtype=None, samples_per_frame: int |
             if rigs[i].info.every != every:
                 rigs[i] = build(cases[i], dtype=dtype, samples_per_frame=samples_per_frame, every=every)
     return rigs, groups
+
+
+def not_run(case: Case, reason: str) -> FormingResult:
+    """The result of a member that never ran (its rig could not be built, or the batch was
+    interrupted before its part): no frames, ``complete = False`` and why."""
+    summary = {"complete": False, "reason": reason, "case": case.name, "inputs": to_dict(case), "max_ke_ie": None,
+               "max_shear_angle_deg": None, "flange_wrinkles": None, "draw_in": None, "wall_time_s": 0.0,
+               "frames_written": 0}
+    return FormingResult(t=np.zeros(0), x=np.zeros((0, 0, 3)), fields={}, history={}, faces=np.zeros((0, 4), np.int64),
+                         ply_id=np.zeros(0, np.int32), info=None, complete=False, reason=reason, wall_time_s=0.0,
+                         summary=summary)
 
 
 def _available_bytes(devices) -> float:
@@ -151,13 +176,12 @@ def _available_bytes(devices) -> float:
 
 
 def member_bytes(rig: Rig) -> float:
-    """Estimated memory of one member in a batch program, bytes: its state and model arrays and
-    the temporaries of a step and of the fields (measured: the compiled programs of the presets
-    need 3-5 times their arguments; 8 times is the margin)."""
+    """Estimated memory of one member in a batch program, bytes: :data:`MEMORY_PER_ARRAY_BYTE`
+    times its state and model arrays (the temporaries of a step and of the fields dominate)."""
     model, state, _ = rig
     size = sum(int(np.prod(np.shape(a))) * jnp.dtype(jnp.result_type(a)).itemsize
                for a in jax.tree_util.tree_leaves((model, state)))
-    return 8.0 * size
+    return MEMORY_PER_ARRAY_BYTE * size
 
 
 def plan_parts(rigs, groups, *, devices=None, max_members: int | None = None,
@@ -400,8 +424,9 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
         on_part: ``on_part(part: BatchPart, results)`` after each part (e.g. to write its outputs).
 
     Returns:
-        one :class:`~jaxform.forming.driver.FormingResult` per member, in order (``None`` for the
-        members of parts never started because an earlier part was interrupted); each
+        one :class:`~jaxform.forming.driver.FormingResult` per member, in order (:func:`not_run`
+        for a member whose rig could not be built, or whose part never started because an
+        earlier one was interrupted: no frames, ``complete = False`` and why); each
         ``summary["batch"]`` says which group and part ran it, with how many members and devices.
         Each ``wall_time_s`` is its part's (build and run), shared by the part's members.
     """
@@ -409,11 +434,12 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
         raise TypeError(f"simulate_batch: case is a {type(case).__name__}; give a Case (jaxform.cases.load(name))")
     t0 = time.perf_counter()
     cases = member_cases(case, overrides_per_member, element_size=element_size)
-    rigs, groups = build_members(cases, dtype=dtype)
+    rigs, groups = build_members(cases, dtype=dtype, catch=True)
     parts = plan_parts(rigs, groups, devices=devices, max_members=max_members)
     build_s = time.perf_counter() - t0
     devs = list(jax.local_devices() if devices is None else devices)
-    results: list = [None] * len(cases)
+    results: list = [not_run(c, f"error before the run started: {r}") if isinstance(r, Exception) else None
+                     for c, r in zip(cases, rigs)]
     for part in parts:
         t_part = time.perf_counter()
         prog = None if on_progress is None else (lambda *a, p=part: on_progress(p, *a))
@@ -431,8 +457,10 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
             on_part(part, out)
         if any((r.reason or "").startswith(INTERRUPTED) for r in out):
             break
-    return results
+    return [not_run(c, "not run: the batch was interrupted before its part") if r is None else r
+            for c, r in zip(cases, results)]
 
 
-__all__ = ["INTERRUPTED", "MESH_AXIS", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "member_bytes", "plan_parts",
+__all__ = ["INTERRUPTED", "MESH_AXIS", "MEMORY_PER_ARRAY_BYTE", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "not_run", "member_bytes",
+           "plan_parts",
            "run_part", "simulate_batch"]

@@ -100,6 +100,8 @@ class FormingResult:
 
     def __repr__(self) -> str:
         state = "complete" if self.complete else f"incomplete: {self.reason}"
+        if self.info is None:  # a member of a batch that never ran (jaxform.forming.batch.not_run)
+            return f"FormingResult(case={self.summary.get('case')!r}, {state}, frames=0)"
         return (f"FormingResult(case={self.info.case.name!r}, {state}, frames={len(self.t)}, "
                 f"nodes={len(self.info.x0)}, wall_time_s={self.wall_time_s:.1f})")
 

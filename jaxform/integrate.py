@@ -13,10 +13,10 @@ Central differences (velocities at half steps), the free dofs carrying the momen
     u_{n+1} = u_n + dt v_{n+½},   x_{n+1} = X + u_{n+1}
 
 ``C`` is the inverse mass: ``M^-1`` (lumped), or with a fibre mass (:mod:`jaxform.fibre_mass`)
-the polynomial ``C(x_n)``, whose dependence on the positions adds ``-1/2 d(p_{n-½}^T C p_{n-½})/dx``
-to ``f_n`` (Hamilton's equations for a position-dependent mass). The integrated quantity is the displacement ``u`` from the mesh nodes
-``X`` and the shell is evaluated on it (float32 absolute positions would add rounding noise to
-every strain).
+the polynomial ``C(x_n)``; with its momentum term on, the dependence on the positions adds
+``-1/2 d(p_{n-½}^T C p_{n-½})/dx`` to ``f_n`` (Hamilton's equations for a position-dependent mass).
+The integrated quantity is the displacement ``u`` from the mesh nodes ``X`` and the shell is
+evaluated on it (float32 absolute positions would add rounding noise to every strain).
 
 Energy accounts at step n: elastic parts at ``x_n``; kinetic ``1/2 v_mid . p_mid`` with ``v_mid =
 (v_{n-½} + v_{n+½}) / 2`` (``1/2 m |v_mid|^2`` with the lumped mass; it differs from the exactly

@@ -407,14 +407,23 @@ def chord_angle(profile):
     return jnp.arctan2(-profile.z[-1], profile.x[-1])
 
 
+MAX_RETREATS = 6
+"""Times :func:`standard_test` shortens a strip that does not solve before it gives up."""
+
+
 def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float = 1e-5, max_iter: int = 30,
                   max_residual: float = 1e-5, model=None, **kwargs) -> StandardTestResult:
     """Find the 41.5° overhang (secant iterations on the overhang; host loop), ``B_41.5 = w (L/2)^3``.
 
-    Every strip solved on the way must reach equilibrium: a solver ``residual`` (relative
-    out-of-balance force) above ``max_residual`` (or not finite) raises
-    :class:`CantileverNotConverged`, naming the overhang, as does a secant search that has not met
-    ``tol`` (relative, on the overhang) after ``max_iter`` steps. ``model``: the forward model
+    Every strip the result rests on must reach equilibrium (a solver ``residual``, relative
+    out-of-balance force, at most ``max_residual``). A strip that does not is one the search went
+    too far with: the search starts from Peirce's overhang for the initial stiffness, which for a
+    strongly softening law (the NCF's Voce laws: about 245 mm) hangs almost vertically where the
+    solver cannot follow it; a longer strip always sags more, so the search shortens it (by 0.7
+    when bracketing, halfway back to the last solved overhang in the secant steps, at most
+    ``MAX_RETREATS`` times) instead of failing. :class:`CantileverNotConverged` names the
+    overhang when that does not help, or when the secant search has not met ``tol`` (relative,
+    on the overhang) after ``max_iter`` steps. ``model``: the forward model
     (default the shell, :func:`simulate` with gravity ``g``; another model with the same signature
     keeps its own gravity and may report no ``residual``). ``kwargs`` go to the model.
     """
@@ -423,29 +432,37 @@ def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float 
     model = functools.partial(simulate, g=g) if model is None else model
     w = float(areal_mass) * g
     b0 = float(np.max(np.asarray(max_stiffness(bending))))
-    log = []  # (L, chord angle - 41.5 deg, residual)
+    log = []  # (L, chord angle - 41.5 deg, residual) of the strips that reached equilibrium
 
     def f(L):
         r = model(bending, overhang=L, areal_mass=areal_mass, **kwargs)
         res = float(getattr(r, "residual", 0.0))
-        log.append((L, float(chord_angle(r)) - PEIRCE_ANGLE, res))
         if not res <= max_residual:
             raise CantileverNotConverged(
                 f"standard_test: the cantilever of overhang {1e3 * L:.3f} mm did not converge (residual "
                 f"{res:.2e} > max_residual {max_residual:.1e} after {int(getattr(r, 'iterations', -1))} Newton iterations); "
                 "try more load_steps or max_iter")
+        log.append((L, float(chord_angle(r)) - PEIRCE_ANGLE, res))
         return log[-1][1]
 
+    def solved(L, shorter):
+        """``(L, f(L))``, moving to ``shorter(L)`` while the strip of overhang L does not solve."""
+        for attempt in range(MAX_RETREATS + 1):
+            try:
+                return L, f(L)
+            except CantileverNotConverged:
+                if attempt == MAX_RETREATS:
+                    raise
+                L = shorter(L)
+
     # bracket: start from Peirce with the initial stiffness (a softening law sags more: shorter)
-    L1 = 2.0 * (b0 / w) ** (1.0 / 3.0)
-    f1 = f(L1)
-    L0 = L1 * (0.8 if f1 > 0 else 1.25)
-    f0 = f(L0)
+    L1, f1 = solved(2.0 * (b0 / w) ** (1.0 / 3.0), lambda L: 0.7 * L)
+    L0, f0 = solved(L1 * (0.8 if f1 > 0 else 1.25), lambda L: 0.5 * (L + L1))
     for _ in range(max_iter):
         L2 = L1 - f1 * (L1 - L0) / (f1 - f0)
         L2 = min(max(L2, 0.5 * L1), 2.0 * L1)
-        L0, f0, L1 = L1, f1, L2
-        f1 = f(L1)
+        L0, f0 = L1, f1
+        L1, f1 = solved(L2, lambda L, last=L0: 0.5 * (L + last))
         if abs(L1 - L0) <= tol * L1:
             break
     else:
@@ -457,5 +474,5 @@ def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float 
                               max_residual=max(e[2] for e in log), n_simulations=len(log))
 
 
-__all__ = ["simulate", "standard_test", "chord_angle", "CantileverResult", "StandardTestResult",
+__all__ = ["simulate", "standard_test", "MAX_RETREATS", "chord_angle", "CantileverResult", "StandardTestResult",
            "CantileverNotConverged", "GRAVITY", "PEIRCE_ANGLE"]

@@ -197,58 +197,43 @@ def _cpu_devices(n):
         pass
 
 
-def run(args) -> int:
+def run_members(base, overrides, dirs, *, quiet: bool = False, on_result=None, label: str = "sweep") -> list:
+    """Run the members of ``base`` (one list of ``--set`` overrides each) as batched programs, each
+    into its prepared folder of ``dirs`` exactly as ``jaxform run`` writes it (frames as they come,
+    ``summary.json`` written first as running, plots). Shared by ``jaxform sweep`` and
+    ``jaxform study``.
+
+    ``on_result(j, result, ran)`` is called once per member ``j`` when its summary is written
+    (``ran``: False for a member that never ran: no rig, or an interrupted batch). Returns the
+    :class:`~jaxform.forming.driver.FormingResult` of every member, in order.
+    """
     from jaxform import cases
-    from jaxform.io.frames import FrameWriter, write_json
-    from jaxform.io.output import prepare_output_dir
-
-    vary = parse_vary(args.vary)
-    if args.max_members is not None and args.max_members < 1:
-        raise ValueError(f"--max-members {args.max_members}: need at least 1")
-    _cpu_devices(args.cpu_devices)  # both before anything starts JAX's backend (reading a case can)
-    pid, n_proc = _init_distributed(args)
-    base = cases.resolve(args.case, element_size=None if args.element_size_mm is None else args.element_size_mm * 1e-3,
-                         overrides=args.overrides)
-    combos = list(itertools.product(*[v for _, v in vary]))
-    overrides = [[f"{k}={v}" for (k, _), v in zip(vary, combo)] for combo in combos]
-    member_cases = [cases.apply_overrides(base, ov) for ov in overrides]  # every member's input checked first
-    names = member_names(vary, combos)
-    out = args.out
-    if pid == 0:
-        prepare_output_dir(out, force=args.force, owner="sweep", replaces=("sweep.csv", "sweep_*.png"))
-    if n_proc > 1:  # the others write into DIR once process 0 has checked and claimed it
-        from jax.experimental import multihost_utils
-
-        multihost_utils.sync_global_devices("jaxform sweep: output directory ready")
-    mine = list(range(pid, len(combos), n_proc))
     from jaxform.forming.batch import simulate_batch
+    from jaxform.io.frames import FrameWriter, write_json
 
-    dirs = {i: prepare_output_dir(out / names[i], force=args.force, owner="run", replaces=OUTPUTS) for i in mine}
-    for i in mine:
-        write_json(dirs[i] / "summary.json", {"complete": False, "reason": "running (or killed before it could say why)",
-                                              "case": base.name, "inputs": cases.to_dict(member_cases[i])})
-    writers = {}
+    for ov, d in zip(overrides, dirs):
+        write_json(d / "summary.json", {"complete": False, "reason": "running (or killed before it could say why)",
+                                        "case": base.name, "inputs": cases.to_dict(cases.apply_overrides(base, ov))})
+    writers, done = {}, set()
 
     def on_frame(j, info, k, t, x, fields):
-        i = mine[j]
-        if i not in writers:
-            writers[i] = FrameWriter(dirs[i], info.faces, stem="frames")
-        writers[i].write(t, x, point_data(fields, info.ply_id))
+        if j not in writers:
+            writers[j] = FrameWriter(dirs[j], info.faces, stem="frames")
+        writers[j].write(t, x, point_data(fields, info.ply_id))
 
-    rows = {}
+    def finish(j, res, ran):
+        if ran and len(res.t):
+            save_plots(res, dirs[j])
+        write_json(dirs[j] / "summary.json", res.summary)
+        done.add(j)
+        if on_result is not None:
+            on_result(j, res, ran)
 
     def on_part(part, results):
         for j, res in zip(part.members, results):
-            i = mine[j]
-            if len(res.t):
-                save_plots(res, dirs[i])
-            write_json(dirs[i] / "summary.json", res.summary)
-            rows[i] = _row(i, names[i], vary, combos[i], res, pid)
-            if not args.quiet:
-                state = "complete" if res.complete else f"INCOMPLETE ({res.reason})"
-                print(f"  {names[i]}: {state}", file=sys.stdout, flush=True)
+            finish(j, res, True)
 
-    progress = Progress(quiet=args.quiet, label="sweep")
+    progress = Progress(quiet=quiet, label=label)
     current = [None]
 
     def on_progress(part, step, n_steps, t, punch, elapsed):
@@ -261,20 +246,57 @@ def run(args) -> int:
         if step > 0:
             progress(step, n_steps, t, punch, elapsed)
 
+    try:
+        results = simulate_batch(base, list(overrides), on_frame=on_frame, on_part=on_part, on_progress=on_progress)
+    finally:
+        if current[0] is not None:
+            progress.done()
+    for j, res in enumerate(results):  # members that never ran (no rig, or an interrupted batch): say why
+        if j not in done:
+            finish(j, res, False)
+    return results
+
+
+def run(args) -> int:
+    from jaxform import cases
+    from jaxform.io.output import prepare_output_dir
+
+    vary = parse_vary(args.vary)
+    if args.max_members is not None and args.max_members < 1:
+        raise ValueError(f"--max-members {args.max_members}: need at least 1")
+    _cpu_devices(args.cpu_devices)  # both before anything starts JAX's backend (reading a case can)
+    pid, n_proc = _init_distributed(args)
+    base = cases.resolve(args.case, element_size=None if args.element_size_mm is None else args.element_size_mm * 1e-3,
+                         overrides=args.overrides)
+    combos = list(itertools.product(*[v for _, v in vary]))
+    overrides = [[f"{k}={v}" for (k, _), v in zip(vary, combo)] for combo in combos]
+    for ov in overrides:  # every member's input checked before anything is written
+        cases.apply_overrides(base, ov)
+    names = member_names(vary, combos)
+    out = args.out
+    if pid == 0:
+        prepare_output_dir(out, force=args.force, owner="sweep", replaces=("sweep.csv", "sweep_*.png"))
+    if n_proc > 1:  # the others write into DIR once process 0 has checked and claimed it
+        from jax.experimental import multihost_utils
+
+        multihost_utils.sync_global_devices("jaxform sweep: output directory ready")
+    mine = list(range(pid, len(combos), n_proc))
+
+    dirs = {i: prepare_output_dir(out / names[i], force=args.force, owner="run", replaces=OUTPUTS) for i in mine}
+    rows = {}
+
+    def on_result(j, res, ran):
+        i = mine[j]
+        rows[i] = _row(i, names[i], vary, combos[i], res, pid)
+        if not args.quiet:
+            state = "complete" if res.complete else (f"INCOMPLETE ({res.reason})" if ran else f"NOT RUN ({res.reason})")
+            print(f"  {names[i]}: {state}", file=sys.stdout, flush=True)
+
     if not args.quiet:
         print(f"sweep of {base.name}: {len(combos)} members, {len(mine)} in process {pid} of {n_proc}", flush=True)
-    results = []
     if mine:
-        results = simulate_batch(base, [overrides[i] for i in mine], on_frame=on_frame, on_part=on_part,
-                                 on_progress=on_progress)
-    if current[0] is not None:
-        progress.done()
-    for i, res in zip(mine, results):  # members that never ran (no rig, or an interrupted sweep): say why
-        if i not in rows:
-            write_json(dirs[i] / "summary.json", res.summary)
-            rows[i] = _row(i, names[i], vary, combos[i], res, pid)
-            if not args.quiet:
-                print(f"  {names[i]}: NOT RUN ({res.reason})", flush=True)
+        run_members(base, [overrides[i] for i in mine], [dirs[i] for i in mine], quiet=args.quiet,
+                    on_result=on_result)
     every = _gather_rows(rows, len(combos)) if n_proc > 1 else [rows[i] for i in range(len(combos))]
     if pid == 0:
         from jaxform.plots.sweep import sweep_plots

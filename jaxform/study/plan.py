@@ -1,0 +1,127 @@
+"""The runs of the paper study (``jaxform study paper``): which cases, with which settings, and
+whether a run already in the study's folder can be reused.
+
+The study runs, for both fabrics, Case A with NLBM, LBM (B_init, B_41.5, B_inf) and membrane only,
+and Case B with NLBM: the twelve presets of :mod:`jaxform.forming.presets`, each in the folder
+``DIR/runs/<preset>/``. Runs of one fabric's Case A are batched (they share the mesh;
+:func:`jaxform.forming.batch.simulate_batch` groups them by program structure).
+"""
+from __future__ import annotations
+
+import dataclasses
+import json
+import pathlib
+
+from jaxform.forming.case import BENDING_MODELS
+
+SETS = {"case-a-woven": ("woven", "a"), "case-a-ncf": ("ncf", "a"), "case-b": (None, "b")}
+"""The study's parts (``--only``): name -> (fabric or None for both, paper case)."""
+SETTINGS = ("numerics.fibre_mass_scaling=auto",)
+"""Overrides every study run gets before the user's ``--set`` (the presets' punch speed is kept:
+see the report's numerics section for what that means)."""
+RUNS_DIR = "runs"
+"""Sub-folder of the study holding one ``jaxform run`` folder per run."""
+
+
+@dataclasses.dataclass(frozen=True)
+class StudyRun:
+    """One run of the study.
+
+    Attributes:
+        name: the preset (and folder) name, e.g. ``case-a-ncf-lbm-41``; part: key of :data:`SETS`;
+        fabric: ``woven``/``ncf``; bending: one of ``BENDING_MODELS``; paper_case: ``a``/``b``;
+        base: the preset the run's batch starts from; overrides: ``--set`` items making the base
+        this run (name, bending law, settings, element size).
+    """
+
+    name: str
+    part: str
+    fabric: str
+    bending: str
+    paper_case: str
+    base: str
+    overrides: tuple
+
+    def case(self):
+        """The :class:`~jaxform.forming.case.Case` this run uses."""
+        from jaxform import cases
+
+        return cases.apply_overrides(cases.load(self.base), list(self.overrides))
+
+
+def plan(*, only=None, bending=None, element_size_mm: float | None = None, settings=()) -> list[StudyRun]:
+    """The study's runs, in order (``only``: one key of :data:`SETS`, or None for all; ``bending``:
+    the bending models to run, default all of ``BENDING_MODELS``; Case B runs NLBM only).
+
+    Raises ``ValueError`` for an unknown part or bending model, or a setting that is not a valid
+    case override.
+    """
+    from jaxform import cases
+
+    if only is not None and only not in SETS:
+        raise ValueError(f"--only {only!r}: the study's parts are {', '.join(SETS)}")
+    bending = tuple(BENDING_MODELS if bending is None else bending)
+    bad = [b for b in bending if b not in BENDING_MODELS]
+    if bad or not bending:
+        raise ValueError(f"--bending {','.join(bending)}: choose from {', '.join(BENDING_MODELS)}")
+    common = [*SETTINGS, *settings]
+    if element_size_mm is not None:
+        if not element_size_mm > 0:
+            raise ValueError(f"--element-size-mm {element_size_mm}: must be > 0")
+        common.append(f"blank.element_size_mm={float(element_size_mm)!r}")
+    runs = []
+    for part, (fabric, paper_case) in SETS.items():
+        if only is not None and part != only:
+            continue
+        if paper_case == "a":
+            variants = [(fabric, b) for b in BENDING_MODELS if b in bending]
+        else:
+            variants = [("woven", "nlbm"), ("ncf", "nlbm")] if "nlbm" in bending else []
+        for fab, bend in variants:
+            name = f"case-{paper_case}-{fab}-{bend}"
+            base = f"case-{paper_case}-{fab}-nlbm"
+            own = [f"name={json.dumps(name)}"]
+            if bend != "nlbm":
+                own.append(f"fabric.bending={json.dumps(bend)}")
+            runs.append(StudyRun(name, part, fab, bend, paper_case, base, tuple(own + common)))
+    for r in runs:  # every input checked before anything runs
+        cases.apply_overrides(cases.load(r.base), list(r.overrides))
+    return runs
+
+
+NOT_ENDED = ("running", "not run", "interrupted", "error before")
+"""Beginnings of the reasons of runs that did not end by themselves (their outcome says nothing)."""
+
+
+def failed_by_itself(m: dict) -> bool:
+    """Whether a run ended incomplete for a reason of its own (blow-up, physical bounds), not
+    because it never ran, is still running or was interrupted."""
+    reason = m.get("reason") or ""
+    return not m.get("complete") and not reason.startswith(NOT_ENDED) and "terminated" not in reason
+
+
+def _comparable(inputs: dict) -> dict:
+    d = json.loads(json.dumps(inputs))
+    d.pop("description", None)
+    return d
+
+
+def finished(run: StudyRun, folder) -> str | None:
+    """Why the run in ``folder`` can be reused (None when it must run): its ``summary.json`` says
+    it ended (complete, or failed for a reason of its own) with this run's inputs. A run that is
+    still 'running', was interrupted, or ran other inputs (another element size or setting) is redone."""
+    from jaxform import cases
+
+    path = pathlib.Path(folder) / "summary.json"
+    try:
+        s = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return None
+    if not s.get("complete") and not failed_by_itself(s):
+        return None
+    if _comparable(s.get("inputs") or {}) != _comparable(cases.to_dict(run.case())):
+        return None
+    return "complete" if s.get("complete") else f"failed: {s.get('reason')}"
+
+
+__all__ = ["SETS", "SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "finished"]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from jaxform.study.measures import about_x_axis
 from jaxform.study.plan import failed_by_itself
 
 DIAGONAL_TOL_DEG = 15.0
@@ -226,8 +227,7 @@ def claim_4(m):
 
 
 def _by_axis(wrinkles, key):
-    ang = np.array([w["angle_deg"] for w in wrinkles]) if wrinkles else np.zeros(0)
-    about_x = np.abs(((ang + 45.0) % 180.0) - 45.0) < 45.0
+    about_x = about_x_axis([w["angle_deg"] for w in wrinkles])
     vals = np.array([w[key] for w in wrinkles]) if wrinkles else np.zeros(0)
     mean = lambda v: float(v.mean()) if v.size else None  # noqa: E731
     return {"x": mean(vals[about_x]), "y": mean(vals[~about_x])}
@@ -327,7 +327,7 @@ def claim_8(m):
     ang = p1["fibre_strain_min_angle_deg"]
     checks = [about[pos_axis] > 0, p1.get("wrinkle_zone_nodes_500_1500", 0) > 0,
               br.get("max") is not None and br["max"] <= 1.5 * 2.6e-3
-              and BRIDGING_ABOUT_1MM[0] <= br["mean"] <= BRIDGING_ABOUT_1MM[1],
+              and BRIDGING_ABOUT_1MM[0] <= br.get("mean", 0.0) <= BRIDGING_ABOUT_1MM[1],
               _off_diagonal(ang) <= 22.5]
     measured = {"wrinkles_about": about, "positive_shear_axis": pos_axis, "shear_mean_about_deg": sign,
                 "wrinkle_zone_nodes_500_1500": p1.get("wrinkle_zone_nodes_500_1500"),

@@ -125,10 +125,14 @@ def _stats(v) -> dict:
     return {"mean": float(v.mean()), "p95": float(np.percentile(v, 95)), "max": float(v.max())}
 
 
+def about_x_axis(angle_deg) -> np.ndarray:
+    """Whether each angle (deg, top view) is within 45 deg of the +-x axes (else it is about the +-y axes)."""
+    return np.abs(((np.asarray(angle_deg, float) + 45.0) % 180.0) - 45.0) < 45.0
+
+
 def _sector_counts(wrinkles) -> dict:
     """Wrinkles about the +-x axes (within 45 deg of 0 or 180 deg) and about the +-y axes."""
-    ang = np.array([w["angle_deg"] for w in wrinkles]) if wrinkles else np.zeros(0)
-    about_x = np.abs(((ang + 45.0) % 180.0) - 45.0) < 45.0
+    about_x = about_x_axis([w["angle_deg"] for w in wrinkles])
     return {"x": int(np.sum(about_x)), "y": int(np.sum(~about_x))}
 
 
@@ -191,7 +195,7 @@ def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = 
         high = g >= np.percentile(g, 90)
         fig["flange_deviation_high_shear_m"] = float(np.mean(d[high]))
         fig["flange_deviation_other_m"] = float(np.mean(d[~high])) if (~high).any() else None
-    about_x = np.abs(((ang + 45.0) % 180.0) - 45.0) < 45.0
+    about_x = about_x_axis(ang)
     fl = flange if flange.any() else np.ones_like(flange)
     fig["shear_mean_about_deg"] = {"x": float(np.mean(gamma[fl & about_x])) if (fl & about_x).any() else None,
                                    "y": float(np.mean(gamma[fl & ~about_x])) if (fl & ~about_x).any() else None}
@@ -250,5 +254,5 @@ def measure_run(run: RunData, *, strokes=()) -> tuple[dict, dict]:
     return out, arrays
 
 
-__all__ = ["DOME_FRACTION", "EDGE_BAND", "SECTION_SAMPLES", "KAPPA_WRINKLE", "RunData", "load_run", "sections",
+__all__ = ["DOME_FRACTION", "EDGE_BAND", "SECTION_SAMPLES", "KAPPA_WRINKLE", "RunData", "about_x_axis", "load_run", "sections",
            "measure_frame", "measure_run"]

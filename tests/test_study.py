@@ -141,18 +141,32 @@ def test_claim_verdicts_on_constructed_measures():
     assert C.claim_1({})["verdict"] == "not measurable"
     # claim 3: counts fall as the stiffness rises (B_inf -> B_41.5 -> B_init)
     dev = {"flange_deviation_m": {"mean": 1e-3}}
-    m = dict(_measure(f"case-a-woven-lbm-{b}", [_w(10.0 * k) for k in range(n)], **dev)
-             for b, n in (("inf", 12), ("41", 8), ("init", 4)))
+    m = dict(_measure(f"case-a-{f}-lbm-{b}", [_w(10.0 * k) for k in range(n)], **dev)
+             for f in ("woven", "ncf") for b, n in (("inf", 12), ("41", 8), ("init", 4)))
     assert C.claim_3(m)["verdict"] == "agree"
     m["case-a-woven-lbm-init"] = _measure("x", [_w(10.0 * k) for k in range(14)], **dev)[1]
-    assert C.claim_3(m)["verdict"] == "disagree"
+    assert C.claim_3(m)["verdict"] == "partly"  # woven disagrees, NCF agrees
+    del m["case-a-ncf-lbm-inf"]
+    c3 = C.claim_3(m)
+    assert c3["verdict"] == "disagree" and "(one fabric only)" in c3["why"]  # what was measured disagrees
     # claim 2: a membrane run that blew up agrees; one that never ran says nothing
     m = dict([_measure("case-a-woven-membrane", [], complete=False, reason="blew up at step 9 (non-finite)"),
               _measure("case-a-ncf-membrane", [], complete=False, reason="running (or killed before it could say why)")])
     c2 = C.claim_2(m)
-    assert c2["verdict"] == "agree" and "not measurable (running" in c2["why"]
+    assert c2["verdict"] == "partly" and "not measurable (running" in c2["why"]  # one of two measured
     del m["case-a-woven-membrane"]
     assert C.claim_2(m)["verdict"] == "not measurable"
+    # claim 5: wrinkles by the shear under them; the LBM B_init run missing leaves it partly measured
+    ncf = [dict(_w(a), shear_mean_deg=sg * 15.0, width_m=wd, length_m=ln)
+           for a, sg, wd, ln in ((0, 1, 0.02, 0.05), (180, 1, 0.02, 0.05), (90, -1, 0.03, 0.07), (270, -1, 0.03, 0.07))]
+    m = dict([_measure("case-a-ncf-nlbm", ncf)])
+    c5 = C.claim_5(m)
+    assert c5["verdict"] == "partly" and c5["measured"]["wrinkles_negative_shear"] == 2, c5
+    assert c5["measured"]["mean_width_m"] == {"positive": 0.02, "negative": 0.03}
+    m["case-a-ncf-lbm-init"] = m["case-a-ncf-nlbm"]
+    m["case-a-ncf-nlbm"]["ply 1"].update(flange_deviation_m={"mean": 1e-3},
+                                         **{f"section {k}": {"rms_m": 1e-3} for k in ("A-A'", "B-B'")})
+    assert C.claim_5(m)["verdict"] == "agree"
     # claim 9: the standard test against Table 1
     c9 = C.claim_9({"woven": {"simulated": 2.39e-4, "table1": 2.2e-4}, "ncf pos": {"simulated": 2.17e-3, "table1": 3.8e-3}})
     assert c9["verdict"] == "partly" and "+9 %" in c9["why"] and "-43 %" in c9["why"]
@@ -191,7 +205,7 @@ def test_report_from_run_folders(tmp_path):
     written, claims, complete = write_study(tmp_path, runs)
     assert not complete and fab.name == "woven-38616"
     verdicts = {c["id"]: c["verdict"] for c in claims}
-    assert verdicts[1] == "agree" and verdicts[2] == "agree" and verdicts[3] == "not measurable"
+    assert verdicts[1] == "agree" and verdicts[2] == "partly" and verdicts[3] == "not measurable"  # NCF not run
     assert "+9 %" in claims[8]["why"]
     text = (tmp_path / "report.md").read_text()
     assert "blew up at step 5" in text and "### Claim 1: agree" in text

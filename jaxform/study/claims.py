@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from jaxform.study.measures import about_x_axis
 from jaxform.study.plan import failed_by_itself
 
 DIAGONAL_TOL_DEG = 15.0
@@ -41,15 +40,15 @@ CRITERIA = {
     3: "census counts non-increasing from B_inf to B_41.5 to B_init, and B_inf > B_init",
     4: "mean and 95th percentile of M_f^RMS higher with LBM (B_41.5) than NLBM; the top 2 % of M_f^RMS "
        "nodes (median radius) inside the holder-edge band",
-    5: "NCF NLBM census: wrinkles about both axes; the wrinkles about y (negative shear) wider and longer on "
-       f"average than about x; LBM B_init close to NLBM (counts within 1, flange deviation and section RMS "
-       f"within {100 * CLOSE_REL:g} %)",
-    6: "at 30 mm, the flange's deviation larger where shear is high (top 10 % of |shear|) than elsewhere; at 40 "
-       "mm, more census wrinkles about the positive-shear axis than the negative",
+    5: "NCF NLBM census, each wrinkle's shear region by the mean signed shear under it: wrinkles in both "
+       "regions; the negative-shear ones wider and longer on average than the positive-shear ones; LBM B_init close "
+       f"to NLBM (counts within 1, flange deviation and section RMS within {100 * CLOSE_REL:g} %)",
+    6: "at 30 mm, census wrinkles whose mean |shear| beneath is above the flange's mean |shear|; at 40 mm, more "
+       "census wrinkles in positive-shear than in negative-shear regions (by the mean signed shear under each)",
     7: f"ply 1's mean bridging at the punch's base in [{1e3 * BRIDGING_ABOUT_1MM[0]:g}, "
        f"{1e3 * BRIDGING_ABOUT_1MM[1]:g}] mm; no census wrinkle and no wrinkle-zone node with kappa_max in "
        f"{KAPPA_RANGE[0]:g}-{KAPPA_RANGE[1]:g} 1/m",
-    8: f"census wrinkles about the positive-shear axis; wrinkle-zone nodes with kappa_max in {KAPPA_RANGE[0]:g}-"
+    8: f"census wrinkles in positive-shear regions (mean signed shear under them); wrinkle-zone nodes with kappa_max in {KAPPA_RANGE[0]:g}-"
        f"{KAPPA_RANGE[1]:g} 1/m; largest bridging <= 2.6 mm x 1.5 and mean bridging about 1 mm; most compressive "
        "fibre strain within 22.5 deg of a diagonal (the boundary of the shear regions)",
     9: f"B_41.5 simulated with the NLBM laws within {100 * B41_TOL:g} % of Table 1's measured value",
@@ -99,8 +98,15 @@ def _unmeasurable(i, runs, missing):
     return _claim(i, runs, {}, "not measurable", "needs complete runs of " + ", ".join(missing))
 
 
-def _verdict(checks: list[bool]) -> str:
-    return "agree" if all(checks) else ("partly" if any(checks) else "disagree")
+def _verdict(checks: list) -> str:
+    """``agree`` when every check holds, ``partly`` when some do (or some could not be measured:
+    None), ``disagree`` when none holds, ``not measurable`` when none could be measured."""
+    known = [c for c in checks if c is not None]
+    if not known:
+        return "not measurable"
+    if all(known) and len(known) == len(checks):
+        return "agree"
+    return "partly" if any(known) else "disagree"
 
 
 def _off_diagonal(angle):
@@ -170,6 +176,7 @@ def claim_2(m):
                 checks.append(True)
                 bits.append(f"{n} unstable ({r.get('reason')})")
             else:
+                checks.append(None)
                 bits.append(f"{n} not measurable ({r.get('reason')})")
             continue
         p1 = r["ply 1"]
@@ -179,8 +186,7 @@ def claim_2(m):
         checks.append(irregular)
         bits.append(f"{n}: {p1['flange_wrinkles']} wrinkles, mirror error {100 * _sym(p1):.1f} %, KE/IE "
                     f"{r.get('max_ke_ie') or float('nan'):.2f}")
-    if not checks:
-        return _claim(2, names, measured, "not measurable", "; ".join(bits))
+    checks += [None] * (len(names) - len(present))
     return _claim(2, names, measured, _verdict(checks), "; ".join(bits))
 
 
@@ -191,15 +197,16 @@ def claim_3(m):
         names = [f"case-a-{f}-lbm-{b}" for b in ("inf", "41", "init")]
         if _missing(m, names):
             out[f] = {"missing": _missing(m, names)}
+            checks.append(None)
             continue
         counts = [m[n]["ply 1"]["flange_wrinkles"] for n in names]
         dev = [m[n]["ply 1"]["flange_deviation_m"]["mean"] for n in names]
         out[f] = {"counts_inf_41_init": counts, "flange_deviation_mean_m_inf_41_init": dev}
         checks.append(counts[0] >= counts[1] >= counts[2] and counts[0] > counts[2])
         bits.append(f"{f}: {counts[0]} -> {counts[1]} -> {counts[2]} wrinkles")
-    if not checks:
+    if not bits:
         return _unmeasurable(3, runs, sum((v["missing"] for v in out.values()), []))
-    return _claim(3, runs, out, _verdict(checks), "; ".join(bits) + ("" if len(checks) == 2 else " (one fabric only)"))
+    return _claim(3, runs, out, _verdict(checks), "; ".join(bits) + ("" if len(bits) == 2 else " (one fabric only)"))
 
 
 def claim_4(m):
@@ -209,6 +216,7 @@ def claim_4(m):
         lbm, nlbm = f"case-a-{f}-lbm-41", f"case-a-{f}-nlbm"
         if _missing(m, [lbm, nlbm]):
             out[f] = {"missing": _missing(m, [lbm, nlbm])}
+            checks += [None, None]
             continue
         a, b = m[lbm]["ply 1"], m[nlbm]["ply 1"]
         band = a["edge_band_m"]
@@ -221,16 +229,20 @@ def claim_4(m):
         bits.append(f"{f}: mean {1e3 * a['M_f_rms_N']['mean']:.2f} vs {1e3 * b['M_f_rms_N']['mean']:.2f} mN "
                     f"(LBM B_41.5 vs NLBM), top 2 % at r = {1e3 * a['M_f_rms_top2pc_median_radius_m']:.0f} / "
                     f"{1e3 * b['M_f_rms_top2pc_median_radius_m']:.0f} mm (band {1e3 * band[0]:.0f}-{1e3 * band[1]:.0f})")
-    if not checks:
+    if not bits:
         return _unmeasurable(4, runs, sum((v["missing"] for v in out.values()), []))
     return _claim(4, runs, out, _verdict(checks), "; ".join(bits))
 
 
-def _by_axis(wrinkles, key):
-    about_x = about_x_axis([w["angle_deg"] for w in wrinkles])
-    vals = np.array([w[key] for w in wrinkles]) if wrinkles else np.zeros(0)
-    mean = lambda v: float(v.mean()) if v.size else None  # noqa: E731
-    return {"x": mean(vals[about_x]), "y": mean(vals[~about_x])}
+def _by_sign(wrinkles) -> tuple[list, list]:
+    """Census wrinkles in positive- and in negative-shear regions (the mean signed shear under each)."""
+    pos = [w for w in wrinkles if (w.get("shear_mean_deg") or 0.0) > 0.0]
+    neg = [w for w in wrinkles if (w.get("shear_mean_deg") or 0.0) < 0.0]
+    return pos, neg
+
+
+def _mean(wrinkles, key):
+    return float(np.mean([w[key] for w in wrinkles])) if wrinkles else None
 
 
 def claim_5(m):
@@ -238,17 +250,19 @@ def claim_5(m):
     if _missing(m, [nl]):
         return _unmeasurable(5, [nl, init], _missing(m, [nl]))
     p1 = m[nl]["ply 1"]
-    about = p1["wrinkles_about"]
-    width, length = _by_axis(p1["wrinkles"], "width_m"), _by_axis(p1["wrinkles"], "length_m")
-    both = about["x"] > 0 and about["y"] > 0
-    wider = both and width["y"] > width["x"] and length["y"] > length["x"]
-    measured = {"wrinkles_about": about, "mean_width_m": width, "mean_length_m": length,
+    pos, neg = _by_sign(p1["wrinkles"])
+    both = bool(pos) and bool(neg)
+    width = {"positive": _mean(pos, "width_m"), "negative": _mean(neg, "width_m")}
+    length = {"positive": _mean(pos, "length_m"), "negative": _mean(neg, "length_m")}
+    wider = both and width["negative"] > width["positive"] and length["negative"] > length["positive"]
+    measured = {"wrinkles_positive_shear": len(pos), "wrinkles_negative_shear": len(neg), "mean_width_m": width,
+                "mean_length_m": length, "wrinkles_about_axes": p1.get("wrinkles_about"),
                 "shear_mean_about_deg": p1.get("shear_mean_about_deg")}
     checks = [both, wider]
-    why = f"NLBM: {about['x']} wrinkles about x, {about['y']} about y"
+    why = f"NLBM: {len(pos)} wrinkles in positive-shear regions, {len(neg)} in negative"
     if both:
-        why += (f"; widths {1e3 * width['x']:.0f} (x) vs {1e3 * width['y']:.0f} mm (y), lengths "
-                f"{1e3 * length['x']:.0f} vs {1e3 * length['y']:.0f} mm")
+        why += (f"; widths {1e3 * width['positive']:.0f} (positive) vs {1e3 * width['negative']:.0f} mm (negative), "
+                f"lengths {1e3 * length['positive']:.0f} vs {1e3 * length['negative']:.0f} mm")
     if not _missing(m, [init]):
         q = m[init]["ply 1"]
         close = (abs(q["flange_wrinkles"] - p1["flange_wrinkles"]) <= 1
@@ -262,6 +276,7 @@ def claim_5(m):
         checks.append(close)
         why += f"; LBM B_init {'close to' if close else 'not close to'} NLBM"
     else:
+        checks.append(None)
         why += f"; LBM B_init: {', '.join(_missing(m, [init]))}"
     return _claim(5, [nl, init], measured, _verdict(checks), why)
 
@@ -277,18 +292,20 @@ def claim_6(m):
     if _missing(m, [nl]) or "stroke 30 mm" not in m[nl] or "stroke 40 mm" not in m[nl]:
         return _unmeasurable(6, [nl], _missing(m, [nl]) or [f"{nl} (no frames at 30 and 40 mm)"])
     s30, s40 = m[nl]["stroke 30 mm"], m[nl]["stroke 40 mm"]
-    high, other = s30["flange_deviation_high_shear_m"], s30["flange_deviation_other_m"]
-    sign = s40.get("shear_mean_about_deg") or {}
-    pos_axis = "x" if (sign.get("x") or 0.0) >= (sign.get("y") or 0.0) else "y"
-    neg_axis = "y" if pos_axis == "x" else "x"
-    about = s40["wrinkles_about"]
-    checks = [high > other, about[pos_axis] > about[neg_axis]]
-    measured = {"stroke_30_m": s30["stroke_m"], "deviation_high_shear_m": high, "deviation_other_m": other,
-                "correlation": s30.get("flange_deviation_shear_correlation"), "stroke_40_m": s40["stroke_m"],
-                "wrinkles_about_at_40": about, "shear_mean_about_deg_at_40": sign, "positive_shear_axis": pos_axis}
-    why = (f"at {1e3 * s30['stroke_m']:.0f} mm: deviation {1e3 * high:.2f} mm where shear is high vs "
-           f"{1e3 * other:.2f} mm elsewhere; at {1e3 * s40['stroke_m']:.0f} mm: {about[pos_axis]} wrinkles about the "
-           f"positive-shear axis ({pos_axis}) vs {about[neg_axis]} about {neg_axis}")
+    w30 = s30["wrinkles"]
+    under = _mean([w for w in w30 if w.get("shear_abs_mean_deg") is not None], "shear_abs_mean_deg")
+    flange = s30.get("flange_shear_abs_mean_deg")
+    pos, neg = _by_sign(s40["wrinkles"])
+    checks = [under is not None and flange is not None and under > flange, len(pos) > len(neg)]
+    measured = {"stroke_30_m": s30["stroke_m"], "wrinkles_at_30": len(w30), "shear_abs_under_wrinkles_deg": under,
+                "flange_shear_abs_mean_deg": flange, "deviation_high_shear_m": s30["flange_deviation_high_shear_m"],
+                "deviation_other_m": s30["flange_deviation_other_m"], "stroke_40_m": s40["stroke_m"],
+                "wrinkles_positive_shear_at_40": len(pos), "wrinkles_negative_shear_at_40": len(neg)}
+    why = (f"at {1e3 * s30['stroke_m']:.0f} mm: {len(w30)} wrinkles, mean |shear| under them "
+           f"{'n/a' if under is None else f'{under:.1f}'} deg vs {flange:.1f} deg over the flange (the flange's "
+           f"deviation {1e3 * s30['flange_deviation_high_shear_m']:.2f} mm where |shear| is in its top 10 % vs "
+           f"{1e3 * s30['flange_deviation_other_m']:.2f} mm elsewhere); at {1e3 * s40['stroke_m']:.0f} mm: {len(pos)} "
+           f"wrinkles in positive-shear regions vs {len(neg)} in negative")
     return _claim(6, [nl], measured, _verdict(checks), why)
 
 
@@ -321,22 +338,19 @@ def claim_8(m):
         return _unmeasurable(8, [name], _missing(m, [name]))
     p1 = m[name]["ply 1"]
     br = _bridging(p1)
-    sign = p1.get("shear_mean_about_deg") or {}
-    pos_axis = "x" if (sign.get("x") or 0.0) >= (sign.get("y") or 0.0) else "y"
-    about = p1["wrinkles_about"]
+    pos, neg = _by_sign(p1["wrinkles"])
     ang = p1["fibre_strain_min_angle_deg"]
-    checks = [about[pos_axis] > 0, p1.get("wrinkle_zone_nodes_500_1500", 0) > 0,
+    checks = [len(pos) > 0, p1.get("wrinkle_zone_nodes_500_1500", 0) > 0,
               br.get("max") is not None and br["max"] <= 1.5 * 2.6e-3
               and BRIDGING_ABOUT_1MM[0] <= br.get("mean", 0.0) <= BRIDGING_ABOUT_1MM[1],
               _off_diagonal(ang) <= 22.5]
-    measured = {"wrinkles_about": about, "positive_shear_axis": pos_axis, "shear_mean_about_deg": sign,
+    measured = {"wrinkles_positive_shear": len(pos), "wrinkles_negative_shear": len(neg),
                 "wrinkle_zone_nodes_500_1500": p1.get("wrinkle_zone_nodes_500_1500"),
                 "kappa_max_wrinkle_zone_per_m": p1.get("kappa_max_wrinkle_zone_per_m"), "bridging_at_base_m": br,
                 "bridging_m": p1.get("bridging_m"), "fibre_strain_min": p1["fibre_strain_min"],
                 "fibre_strain_min_angle_deg": ang}
     mx, mean = br.get("max"), br.get("mean")
-    why = (f"{about[pos_axis]} wrinkles about the positive-shear axis ({pos_axis}), {about['y' if pos_axis == 'x' else 'x']} "
-           f"about the other; {p1.get('wrinkle_zone_nodes_500_1500')} wrinkle-zone nodes at 500-1500 1/m; bridging at "
+    why = (f"{len(pos)} wrinkles in positive-shear regions, {len(neg)} in negative; {p1.get('wrinkle_zone_nodes_500_1500')} wrinkle-zone nodes at 500-1500 1/m; bridging at "
            f"the base {'n/a' if mean is None else f'{1e3 * mean:.2f} mm mean, {1e3 * mx:.2f} mm max'}; most compressive "
            f"fibre strain {p1['fibre_strain_min']:.2e} at {ang:.0f} deg")
     return _claim(8, [name], measured, _verdict(checks), why)

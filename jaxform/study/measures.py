@@ -136,6 +136,12 @@ def _sector_counts(wrinkles) -> dict:
     return {"x": int(np.sum(about_x)), "y": int(np.sum(~about_x))}
 
 
+def _under(w: dict, r, ang) -> np.ndarray:
+    """(N,) nodes under a census wrinkle: within its radial extent and half its width of its angle."""
+    dth = np.radians((ang - w["angle_deg"] + 180.0) % 360.0 - 180.0)
+    return (r >= w["r_inner_m"]) & (r <= w["r_outer_m"]) & (np.abs(dth) * r <= 0.5 * max(w["width_m"], 1e-3))
+
+
 def _census(case, x, dev, faces):
     from jaxform.forming.summary import flange_census
 
@@ -200,7 +206,12 @@ def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = 
     fig["shear_mean_about_deg"] = {"x": float(np.mean(gamma[fl & about_x])) if (fl & about_x).any() else None,
                                    "y": float(np.mean(gamma[fl & ~about_x])) if (fl & ~about_x).any() else None}
     census = _census(case, x, dev, faces)
+    for w in census:  # the shear under each wrinkle: which shear region it lies in
+        under = _under(w, r, ang)
+        w["shear_mean_deg"] = float(np.mean(gamma[under])) if under.any() else None
+        w["shear_abs_mean_deg"] = float(np.mean(np.abs(gamma[under]))) if under.any() else None
     fig["wrinkles"] = census
+    fig["flange_shear_abs_mean_deg"] = float(np.mean(np.abs(gamma[flange]))) if flange.any() else None
     fig["flange_wrinkles"] = len(census)
     fig["wrinkles_about"] = _sector_counts(census)
     arrays = {"x": x, "faces": faces, "data": data, "r": r, "angle_deg": ang, "sections": {}}

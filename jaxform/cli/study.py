@@ -3,8 +3,8 @@
 Runs Case A for both fabrics with NLBM, LBM (B_init, B_41.5, B_inf) and membrane only, and Case B
 with NLBM for both fabrics (:mod:`jaxform.study.plan`), each into ``DIR/runs/<preset>/`` exactly as
 ``jaxform run`` writes it, the runs of one fabric's Case A as batched programs. The study is
-resumable: a run whose folder says it ended with the same inputs is not redone (an interrupted
-one is). Then it measures every run from its files (:mod:`jaxform.study.measures`) and writes:
+resumable: a run whose folder says it ended with the same inputs is not redone; an interrupted
+one, or one with other inputs, is run again into its folder. Then it measures every run from its files (:mod:`jaxform.study.measures`) and writes:
 
 * ``DIR/report.md``: the runs (time, KE/IE, numerics), every claim with the paper's statement,
   jaxform's figures and the verdict, and the figures below;

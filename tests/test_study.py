@@ -230,6 +230,12 @@ def test_cli_analyses_a_study_folder_and_refuses_bad_input(tmp_path, capsys):
     assert main(args + ["--bending", "nlbm"]) == 0  # the one run asked for is complete
     assert "claims:" in capsys.readouterr().out and (out / "report.md").is_file()
     assert main(args) == 1  # the other four variants are missing
+    # the same folder analysed as a 4 mm study: the 8 mm run is not taken for it
+    other = [a if a != "8" else "4" for a in args] + ["--bending", "nlbm"]
+    assert main(other) == 1
+    text = (out / "report.md").read_text()
+    assert "other inputs: blank.element_size_mm = 8.0 (this study: 4.0)" in text
+    assert "### Claim 1: not measurable" in text
     assert main(args + ["--bending", "lbm-42"]) == 2
     assert main(["study", "paper", "--out", str(out), "--only", "case-c"]) == 2
     (tmp_path / "mine").mkdir()

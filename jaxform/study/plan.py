@@ -114,22 +114,40 @@ def _comparable(inputs: dict) -> dict:
     return d
 
 
-def finished(run: StudyRun, folder) -> str | None:
-    """Why the run in ``folder`` can be reused (None when it must run): its ``summary.json`` says
-    it ended (complete, or failed for a reason of its own) with this run's inputs. A run that is
-    still 'running', was interrupted, or ran other inputs (another element size or setting) is redone."""
+def _differences(have: dict, want: dict, prefix: str = "") -> list[str]:
+    out = []
+    for k in sorted(set(have) | set(want)):
+        h, w = have.get(k), want.get(k)
+        if isinstance(h, dict) and isinstance(w, dict):
+            out += _differences(h, w, f"{prefix}{k}.")
+        elif h != w:
+            out.append(f"{prefix}{k} = {h!r} (this study: {w!r})")
+    return out
+
+
+def run_state(run: StudyRun, folder) -> tuple[bool, str]:
+    """``(reusable, why)`` for the run in ``folder``: reusable when its ``summary.json`` says it
+    ended (complete, or failed for a reason of its own) with this run's inputs. A run that is
+    missing, still 'running', was interrupted, or ran other inputs (another element size or
+    setting) is not, and ``why`` says which."""
     from jaxform import cases
 
-    path = pathlib.Path(folder) / "summary.json"
     try:
-        s = json.loads(path.read_text())
+        s = json.loads((pathlib.Path(folder) / "summary.json").read_text())
     except (OSError, ValueError):
-        return None
+        return False, "not run"
     if not s.get("complete") and not failed_by_itself(s):
-        return None
-    if _comparable(s.get("inputs") or {}) != _comparable(cases.to_dict(run.case())):
-        return None
-    return "complete" if s.get("complete") else f"failed: {s.get('reason')}"
+        return False, s.get("reason") or "not run"
+    diff = _differences(_comparable(s.get("inputs") or {}), _comparable(cases.to_dict(run.case())))
+    if diff:
+        return False, f"the run there has other inputs: {'; '.join(diff[:3])}"
+    return True, "complete" if s.get("complete") else f"failed: {s.get('reason')}"
 
 
-__all__ = ["SETS", "SETTINGS", "FABRIC_SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "finished"]
+def finished(run: StudyRun, folder) -> str | None:
+    """Why the run in ``folder`` can be reused, or None when it must run (:func:`run_state`)."""
+    reusable, why = run_state(run, folder)
+    return why if reusable else None
+
+
+__all__ = ["SETS", "SETTINGS", "FABRIC_SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "run_state", "finished"]

@@ -15,7 +15,7 @@ import pathlib
 
 from jaxform.study import claims as C
 from jaxform.study.measures import load_run, measure_run, sections
-from jaxform.study.plan import RUNS_DIR
+from jaxform.study.plan import RUNS_DIR, run_state
 
 REPORT_OUTPUTS = ("report.md", "claims.json", "measures.json", "fig_*.png", "sections/*.csv")
 """What :func:`write_study` writes (a rerun replaces all of it; the runs and the standard-test cache stay)."""
@@ -25,19 +25,26 @@ STANDARD_TEST_CACHE = "standard_test.json"
 
 
 def _measure(runs, root: pathlib.Path):
+    """Measures of the runs that ended with the study's inputs; the others say why they are not
+    measured (not run, still running, interrupted, or another element size or setting)."""
     measures, arrays, cases = {}, {}, {}
     for r in runs:
         folder = root / r.name
         cases[r.name] = r.case()
-        try:
-            data = load_run(folder)
-        except (ValueError, KeyError):
+        reusable, why = run_state(r, folder)
+        data = None
+        if reusable:
+            try:
+                data = load_run(folder)
+            except (ValueError, KeyError) as err:  # it ended before its first frame
+                why = f"{why} ({err})"
+        if data is None:
             summary = {}
             try:
                 summary = json.loads((folder / "summary.json").read_text())
             except (OSError, ValueError):
                 pass
-            measures[r.name] = {"complete": False, "reason": summary.get("reason") or "not run",
+            measures[r.name] = {"complete": False, "reason": why if not reusable else summary.get("reason") or why,
                                 "wall_time_s": summary.get("wall_time_s")}
             continue
         strokes = NCF_STROKES if (r.fabric == "ncf" and r.paper_case == "a") else ()

@@ -309,8 +309,12 @@ def claim_6(m):
     return _claim(6, [nl], measured, _verdict(checks), why)
 
 
-def _bridging(p):
-    return p.get("bridging_at_base_m") or {}
+def _bridging(p) -> tuple[dict, str, bool]:
+    """Ply ``p``'s bridging at the punch's base: ``(figures, text, about 1 mm on average)``."""
+    br = p.get("bridging_at_base_m") or {}
+    mean, mx = br.get("mean"), br.get("max")
+    text = "n/a" if mean is None else f"{1e3 * mean:.2f} mm mean, {1e3 * mx:.2f} mm max"
+    return br, text, mean is not None and BRIDGING_ABOUT_1MM[0] <= mean <= BRIDGING_ABOUT_1MM[1]
 
 
 def claim_7(m):
@@ -318,15 +322,12 @@ def claim_7(m):
     if _missing(m, [name]):
         return _unmeasurable(7, [name], _missing(m, [name]))
     p1 = m[name]["ply 1"]
-    br = _bridging(p1)
-    lo, hi = BRIDGING_ABOUT_1MM
-    checks = [br.get("mean") is not None and lo <= br["mean"] <= hi,
+    br, where, about_1mm = _bridging(p1)
+    checks = [about_1mm,
               p1["flange_wrinkles"] == 0 and p1.get("wrinkle_zone_nodes_500_1500", 0) == 0]
     measured = {"bridging_at_base_m": br, "flange_wrinkles": p1["flange_wrinkles"],
                 "wrinkle_zone_nodes_500_1500": p1.get("wrinkle_zone_nodes_500_1500"),
                 "kappa_max_wrinkle_zone_per_m": p1.get("kappa_max_wrinkle_zone_per_m")}
-    mean, mx = br.get("mean"), br.get("max")
-    where = "n/a" if mean is None else f"{1e3 * mean:.2f} mm mean, {1e3 * mx:.2f} mm max"
     why = (f"bridging at the base {where}; {p1['flange_wrinkles']} census wrinkles, "
            f"{p1.get('wrinkle_zone_nodes_500_1500')} wrinkle-zone nodes at {KAPPA_RANGE[0]:g}-{KAPPA_RANGE[1]:g} 1/m")
     return _claim(7, [name], measured, _verdict(checks), why)
@@ -337,21 +338,19 @@ def claim_8(m):
     if _missing(m, [name]):
         return _unmeasurable(8, [name], _missing(m, [name]))
     p1 = m[name]["ply 1"]
-    br = _bridging(p1)
+    br, where, about_1mm = _bridging(p1)
     pos, neg = _by_sign(p1["wrinkles"])
     ang = p1["fibre_strain_min_angle_deg"]
     checks = [len(pos) > 0, p1.get("wrinkle_zone_nodes_500_1500", 0) > 0,
-              br.get("max") is not None and br["max"] <= 1.5 * 2.6e-3
-              and BRIDGING_ABOUT_1MM[0] <= br.get("mean", 0.0) <= BRIDGING_ABOUT_1MM[1],
+              about_1mm and br["max"] <= 1.5 * 2.6e-3,
               _off_diagonal(ang) <= 22.5]
     measured = {"wrinkles_positive_shear": len(pos), "wrinkles_negative_shear": len(neg),
                 "wrinkle_zone_nodes_500_1500": p1.get("wrinkle_zone_nodes_500_1500"),
                 "kappa_max_wrinkle_zone_per_m": p1.get("kappa_max_wrinkle_zone_per_m"), "bridging_at_base_m": br,
                 "bridging_m": p1.get("bridging_m"), "fibre_strain_min": p1["fibre_strain_min"],
                 "fibre_strain_min_angle_deg": ang}
-    mx, mean = br.get("max"), br.get("mean")
-    why = (f"{len(pos)} wrinkles in positive-shear regions, {len(neg)} in negative; {p1.get('wrinkle_zone_nodes_500_1500')} wrinkle-zone nodes at 500-1500 1/m; bridging at "
-           f"the base {'n/a' if mean is None else f'{1e3 * mean:.2f} mm mean, {1e3 * mx:.2f} mm max'}; most compressive "
+    why = (f"{len(pos)} wrinkles in positive-shear regions, {len(neg)} in negative; "
+           f"{p1.get('wrinkle_zone_nodes_500_1500')} wrinkle-zone nodes at 500-1500 1/m; bridging at the base {where}; most compressive "
            f"fibre strain {p1['fibre_strain_min']:.2e} at {ang:.0f} deg")
     return _claim(8, [name], measured, _verdict(checks), why)
 

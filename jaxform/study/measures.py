@@ -148,7 +148,7 @@ def _census(case, x, dev, faces):
     return [w.to_dict() for w in flange_census(x, dev, faces, case)]
 
 
-def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = True) -> tuple[dict, dict]:
+def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = True, frame=None) -> tuple[dict, dict]:
     """Figures and arrays of frame ``k``, ply ``ply``: ``(figures, arrays)``.
 
     ``figures`` (JSON-ready): stroke, deviation on the dome and the flange, mirror symmetry,
@@ -156,12 +156,13 @@ def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = 
     angle), kappa_max in wrinkle zones, the census of the flange and its counts about the x and y
     axes, the sections' RMS, largest amplitude and peak counts, and the correlation of the flange's
     deviation with its shear. ``arrays``: ``x``, ``faces``, the ply's point data, ``kappa_max``,
-    ``zones`` and the sampled sections ``{name: (s, amplitude, valid)}``.
+    ``zones`` and the sampled sections ``{name: (s, amplitude, valid)}``. ``frame``: frame ``k``
+    as :meth:`RunData.frame` gives it, when already read.
     """
     from jaxform import metrics
     from jaxform.forming.summary import flange_mask, symmetry_error
 
-    x_all, data_all = run.frame(k)
+    x_all, data_all = run.frame(k) if frame is None else frame
     sel, x, faces, data = _ply(run, x_all, data_all, ply)
     case = run.case
     t = case.tools
@@ -257,8 +258,9 @@ def measure_run(run: RunData, *, strokes=()) -> tuple[dict, dict]:
            "numerics": s.get("numerics"), "element_size_m": float(run.case.element_size),
            "frames": len(run.frames)}
     arrays = {}
+    last = run.frame(-1)
     for ply in range(1, int(run.ply_id.max()) + 1):
-        out[f"ply {ply}"], arrays[f"ply {ply}"] = measure_frame(run, -1, ply=ply)
+        out[f"ply {ply}"], arrays[f"ply {ply}"] = measure_frame(run, -1, ply=ply, frame=last)
     for stroke in strokes:
         key = f"stroke {1e3 * stroke:g} mm"
         out[key], arrays[key] = measure_frame(run, run.frame_at_stroke(stroke), curvature=False)

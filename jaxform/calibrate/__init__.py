@@ -5,7 +5,9 @@ law parameters and the strips' similarity), :mod:`~jaxform.calibrate.cantilever_
 length and clamp moment read off a profile), :mod:`~jaxform.calibrate.profiles` (a simulated profile at
 the measured points, its curvature), :mod:`~jaxform.calibrate.cantilever_fit` (bending laws through the
 shell cantilever, on ``scipy.optimize.least_squares``) and :mod:`~jaxform.calibrate.shear_fit`
-(shear laws, checked on the shell's picture frame). The scripts in ``calibration/`` and the readers
+(shear laws, checked on the shell's picture frame), :mod:`~jaxform.calibrate.sections` (measured
+wrinkle sections and their position-tolerant residual) and :mod:`~jaxform.calibrate.wrinkle_fit`
+(the bending law from wrinkle sections through the forming run, optionally with profiles). The scripts in ``calibration/`` and the readers
 in :mod:`jaxform.io.calibration_files` sit on top. SI units throughout.
 """
 from __future__ import annotations
@@ -20,6 +22,8 @@ from jaxform.calibrate.cantilever_fit import (
     initial_guess,
     peirce_b,
 )
+from jaxform.calibrate.sections import Section, check_section
+from jaxform.calibrate.wrinkle_fit import WrinkleFit, fit_wrinkles
 from jaxform.calibrate.profiles import discrete_curvature, interp_profile
 from jaxform.calibrate.shear_fit import (
     ShearFit,
@@ -37,5 +41,5 @@ __all__ = [
     "GRAVITY", "Profile", "CantileverFit", "FitProgress", "ShearFit", "law_from_q", "q_from_law", "interp_profile",
     "discrete_curvature", "peirce_b", "initial_guess", "bounds", "estimate_noise", "fit_cantilever", "standard_test", "chord_angle",
     "fit_shear_polynomial", "fit_shear_ncf", "picture_frame_normalised_force", "picture_frame_shear_angle",
-    "check_shear_fit",
+    "check_shear_fit", "Section", "check_section", "WrinkleFit", "fit_wrinkles",
 ]

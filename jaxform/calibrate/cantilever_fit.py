@@ -314,6 +314,10 @@ class _Model:
         return float((e.r @ e.r - np.sum((e.r + e.J @ d) ** 2)) / sigma**2)
 
 
+ProfileModel = _Model
+"""The profiles' residual model (``rows(q)`` in mm, ``jac(q)``): shared with the joint wrinkle fit."""
+
+
 # ---------------------------------------------------------------------------------------------
 # The fit
 # ---------------------------------------------------------------------------------------------
@@ -514,5 +518,5 @@ def _summarise(profiles, law, q, final: _Evaluation, fitted, n_data, dtype, b41,
         solver_converged=final.converged, noise=noise, trustworthy=not reason, reason=reason, **counts)
 
 
-__all__ = ["Profile", "CantileverFit", "FitProgress", "peirce_b", "bounds",
+__all__ = ["Profile", "ProfileModel", "CantileverFit", "FitProgress", "peirce_b", "bounds",
            "initial_guess", "fit_cantilever", "estimate_noise", "L_REF", "B_INIT_DETERMINED_SD"]

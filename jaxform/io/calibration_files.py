@@ -352,5 +352,57 @@ def read_shear_toml(path_or_text):
     return PolynomialShear(coeffs)
 
 
-__all__ = ["read_profile_csv", "write_profile_csv", "read_shear_csv", "write_json", "shear_toml",
+def parse_line_mm(text: str, owner: str = "--line"):
+    """``"X0,Y0,X1,Y1"`` (mm, top view, punch axis at the origin) → ``(start (2,), end (2,))`` in m."""
+    try:
+        v = [float(t) for t in str(text).split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 4 or not all(math.isfinite(t) for t in v):
+        raise ValueError(f"{owner} {text!r}: give four numbers X0,Y0,X1,Y1 in mm (the section line's end points "
+                         "in the top view, punch axis at the origin)")
+    a, b = np.array(v[:2]) * 1e-3, np.array(v[2:]) * 1e-3
+    return a, b
+
+
+def read_section_csv(path, start, end):
+    """Read a wrinkle section (header ``s_mm,amplitude_mm``) measured along the line from ``start``
+    to ``end`` (m) and return a :class:`jaxform.calibrate.sections.Section` in m.
+
+    Rows are sorted by ``s``; repeated positions are averaged; rows with a missing value are
+    refused by line number. Whether the line fits a case is checked by
+    :func:`jaxform.calibrate.sections.check_section`.
+    """
+    from jaxform.calibrate.sections import MIN_POINTS, Section
+
+    owner = "read_section_csv"
+    cols = _read_columns(path, owner)
+    if "s_mm" not in cols or "amplitude_mm" not in cols:
+        raise ValueError(f"{owner}: {path}: header is {_header(cols)}; it must have columns s_mm,amplitude_mm "
+                         "(position along the line from its start, mm; wrinkle amplitude d_P, mm)")
+    _refuse_missing(owner, path, cols, ("s_mm", "amplitude_mm"))
+    s, a = cols["s_mm"], cols["amplitude_mm"]
+    order = np.argsort(s, kind="stable")
+    s, a = s[order], a[order]
+    us, inv = np.unique(s, return_inverse=True)
+    if us.size < s.size:
+        a = np.bincount(inv, weights=a) / np.bincount(inv)
+        s = us
+    if s.size < MIN_POINTS:
+        raise ValueError(f"{owner}: {path}: {s.size} distinct positions; need at least {MIN_POINTS} along the section")
+    return Section(s * 1e-3, a * 1e-3, np.asarray(start, float), np.asarray(end, float), pathlib.Path(path).name)
+
+
+def write_section_csv(path, s, amplitude, *, force: bool = False) -> pathlib.Path:
+    """Write a section (s, amplitude in m) as ``s_mm,amplitude_mm``; refuses to overwrite unless ``force``."""
+    path = _check_new(path, force)
+    with path.open("w", newline="") as fh:
+        wr = csv.writer(fh)
+        wr.writerow(["s_mm", "amplitude_mm"])
+        for u, v in zip(np.asarray(s) * 1e3, np.asarray(amplitude) * 1e3):
+            wr.writerow([f"{u:.6f}", f"{v:.6f}"])
+    return path
+
+
+__all__ = ["read_profile_csv", "read_section_csv", "write_section_csv", "parse_line_mm", "write_profile_csv", "read_shear_csv", "write_json", "shear_toml",
            "write_shear_toml", "read_shear_toml"]

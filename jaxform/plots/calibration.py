@@ -67,6 +67,45 @@ def shear_fit_figure(fit, gamma, force, *, title: str = ""):
     return fig
 
 
+def wrinkle_fit_figure(fit, sections, *, truth=None, title: str = ""):
+    """Measured, starting and fitted sections (mm), and the starting and fitted M–kappa and
+    B–kappa curves up to past the curvature the wrinkles reach.
+
+    Args:
+        fit: a :class:`jaxform.calibrate.WrinkleFit`.
+        sections: the fitted :class:`jaxform.calibrate.Section` list (m).
+        truth: optional bending law to draw (a round trip's).
+    """
+    n = len(sections)
+    fig, axes = plt.subplots(1, n + 2, figsize=(4.6 * (n + 2), 4.0))
+    for ax, sec, y, y0, rms, rms0 in zip(axes, sections, fit.fitted, fit.initial, fit.rms_per_section,
+                                         fit.rms_initial_per_section):
+        ax.plot(sec.s * 1e3, sec.amplitude * 1e3, ".", ms=3, color="k", label="measured")
+        ax.plot(sec.s * 1e3, np.asarray(y0) * 1e3, "-", lw=1, color="C1", label=f"starting law, RMS {rms0 * 1e3:.2f} mm")
+        ax.plot(sec.s * 1e3, np.asarray(y) * 1e3, "-", lw=1.5, color="C0", label=f"fitted, RMS {rms * 1e3:.2f} mm")
+        ax.set_xlabel("s along the section, mm")
+        ax.set_ylabel("amplitude d_P, mm")
+        ax.set_title(sec.name or "section", fontsize=9)
+        ax.legend(fontsize=7)
+    k = np.linspace(0.0, 1.5 * max(fit.kappa_reach, 1e-9), 400)
+    laws = [("starting", fit.law_initial, "C1"), ("fitted", fit.law, "C0")] + ([("truth", truth, "k")] if truth else [])
+    for name, law, c in laws:
+        axes[n].plot(k, np.asarray(law.moment(k)), color=c, lw=1.5, ls="--" if name == "truth" else "-", label=name)
+        axes[n + 1].plot(k, np.asarray(law.stiffness(k)) * 1e3, color=c, lw=1.5, ls="--" if name == "truth" else "-")
+    for ax, lab in ((axes[n], "moment per width M, N"), (axes[n + 1], "B = dM/dkappa, N·mm")):
+        ax.axvline(fit.kappa_reach, color="grey", ls=":", label="curvature the wrinkles reach")
+        ax.set_xlabel("curvature, 1/m")
+        ax.set_ylabel(lab)
+    axes[n].legend(fontsize=7)
+    axes[n + 1].set_title(f"B_init {fit.values['b_init']:.3g} N·m, B_inf {fit.values['b_inf']:.3g} N·m", fontsize=9)
+    for a in axes:
+        a.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def save(fig, path, dpi: int = 130):
     """Write a figure as PNG and close it."""
     fig.savefig(path, dpi=dpi)
@@ -74,4 +113,4 @@ def save(fig, path, dpi: int = 130):
     return path
 
 
-__all__ = ["cantilever_fit_figure", "shear_fit_figure", "save"]
+__all__ = ["cantilever_fit_figure", "shear_fit_figure", "wrinkle_fit_figure", "save"]

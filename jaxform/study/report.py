@@ -13,6 +13,9 @@ import json
 import math
 import pathlib
 
+import numpy as np
+
+from jaxform.io.calibration_files import write_section_csv
 from jaxform.study import claims as C
 from jaxform.study.measures import load_run, measure_run, sections
 from jaxform.study.plan import RUNS_DIR, run_state
@@ -149,9 +152,8 @@ def _write_sections(out: pathlib.Path, arrays) -> list:
     for name, a in arrays.items():
         for key, (s, v, valid) in a["ply 1"]["sections"].items():
             path = d / f"{name}_{key[0]}.csv"
-            rows = "\n".join(f"{1e3 * si:.4f},{1e3 * vi:.4f}" for si, vi, ok in zip(s, v, valid) if ok)
-            path.write_text("s_mm,amplitude_mm\n" + rows + ("\n" if rows else ""))
-            written.append(path)
+            ok = np.asarray(valid, bool)
+            written.append(write_section_csv(path, np.asarray(s)[ok], np.asarray(v)[ok], force=True))
     return written
 
 

@@ -1,0 +1,493 @@
+"""The bending law (and optionally a shear-law scale) from wrinkle-amplitude sections of a formed
+part, through the forming run itself; jointly with cantilever side profiles when given.
+
+Parameters (log space): ``q = (log B_init, log B_inf/B_init, log kappa0)`` of one symmetric Voce
+law on both fibre families (:mod:`jaxform.calibrate.transforms`, the cantilever fit's), and with
+``params="voce+shear"`` a fourth, ``log s``, that scales the case's shear law (force times ``s``).
+Bounds: ``B_init`` and ``kappa0`` within a factor :data:`SPAN` of the starting law, the ratio in
+``[1e-3, 1]``, ``s`` within a factor 3.
+
+Residual: per section, the Gaussian-smoothed difference of simulated and measured amplitude in
+units of the smoothed noise (:mod:`jaxform.calibrate.sections`: tolerant of small wrinkle shifts),
+and with profiles the cantilever fit's z-residuals in units of their noise. The forming rig is
+built once; each trial law is one ``forming.rollout`` of the whole stroke (members of a batch of
+fixed width: 1 on a CPU, where a vmapped batch is no faster per member; more on an accelerator).
+
+Why not plain gradients. Reverse or forward mode through the run is exact (the README: it equals
+central differences at ``h = 1e-8``) but the buckled flange is chaotically sensitive to the law:
+over a whole stroke the exact derivative is dominated by the choice of bifurcation branch and
+says nothing about the slope of the loss over any finite step (it grows like ``e^{lambda t}``,
+1e4x the ``h = 1e-2`` slope after 1,600 steps). So the fit (1) checks at the start the AD gradient
+of the actual loss against central differences with the fit's step ``fd_step`` (0.05 in log
+space: the scale at which the loss is smooth enough to follow) and records both, (2) uses the AD
+Jacobian only where it agrees with them within :data:`GRAD_RTOL` (the safeguard: otherwise the
+Jacobian by forward differences with ``fd_step``, said in ``gradient_check``), (3) starts from the
+best of a few laws around the starting one (a global phase, one run each) and (4) runs
+``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there. Optional
+``seeds > 1`` averages every evaluation over seeded imperfections of the blank (a smooth random
+out-of-plane field of amplitude ``imperfection``), batched, which smooths the loss further at
+``seeds`` times the cost.
+
+Uncertainty (Laplace / Gauss-Newton): ``cov(q) = c (J^T J)^-1`` with ``J`` the Jacobian used,
+``c`` the reduced chi-square (at least 1) times the ratio of section rows to independent section
+residuals (smoothing correlates neighbouring rows), mapped to ``(b_inf, m0, kappa0, b_init)`` by the
+delta method. A parameter is *determined* where its standard deviation is under
+:data:`DETERMINED_SD` of its value. SI units throughout.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+import time
+from typing import Any, Callable, NamedTuple, Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+from scipy.linalg import block_diag
+from scipy.optimize import least_squares, lsq_linear, minimize
+
+from jaxform import cantilever, forming
+from jaxform.calibrate import sections as sec_mod
+from jaxform.calibrate.cantilever_data import estimate_noise
+from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
+from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law
+from jaxform.forming.fields import state_fields
+from jaxform.metrics import section_nrmse
+from jaxform.materials import AsymmetricBending, LinearBending, VoceBending
+from jaxform.shell import fibre_curvatures
+
+PARAM_KINDS = ("voce", "voce+shear")
+NOISE = 5e-5  # m, a scanner's noise on the amplitude
+FD_STEP = 0.05  # log-space step of the finite differences (the gradient check and the FD Jacobian)
+GRAD_RTOL = 0.3  # AD agrees with central differences where |g_ad - g_fd| <= GRAD_RTOL * |g_fd| (each, and the norm)
+SPAN = 10.0  # B_init and kappa0 are searched within this factor of the starting law
+SHEAR_SPAN = 3.0
+DETERMINED_SD = 0.10
+GRAD_FRAMES = 21  # the fit's rig has this many frames: one checkpoint each in the reverse pass
+KAPPA_PERCENTILE = 98.0  # "the curvatures the wrinkles reach": this percentile of |kappa| on the fitted part
+NAMES = ("B_init", "B_inf/B_init", "kappa0", "shear scale")
+_START_MOVES = ((math.log(2.0), 0.0, 0.0), (-math.log(2.0), 0.0, 0.0), (0.0, 0.0, math.log(3.0)),
+                (0.0, 0.0, -math.log(3.0)), (0.0, -math.log(3.0), 0.0), (math.log(2.0), 0.0, math.log(3.0)),
+                (-math.log(2.0), 0.0, -math.log(3.0)))
+
+
+@dataclasses.dataclass(frozen=True)
+class WrinkleFit:
+    """Result of :func:`fit_wrinkles` (host values, SI; :meth:`as_dict` for ``params.json``)."""
+
+    law: Any
+    law_initial: Any
+    shear_scale: float
+    q: np.ndarray
+    values: dict  # b_inf, m0, kappa0, b_init
+    sigma: dict
+    determined: dict
+    loss_initial: float
+    loss_final: float
+    rms_per_section: list  # m, unsmoothed, at the fitted law
+    rms_initial_per_section: list
+    nrmse_per_section: list  # fractions (section_nrmse), at the fitted law
+    profile_rmse: float | None  # m, the cantilever profiles' z-residual (joint fit)
+    kappa_reach: float  # 1/m, KAPPA_PERCENTILE of |kappa| on the fitted part
+    gradient_check: dict
+    jacobian: str  # "ad" or "fd"
+    iterations: int
+    forming_runs: int
+    wall_time: float
+    converged: bool
+    reason: str
+    starts: list  # (q, loss) of the global phase
+    fitted: list  # (m,) simulated amplitude per section at the fitted law, m
+    initial: list  # the same at the starting law
+    covariance: np.ndarray
+
+    def as_dict(self) -> dict:
+        v, s = self.values, self.sigma
+        out = {"b_inf_Nm": v["b_inf"], "m0_N": v["m0"], "kappa0_per_m": v["kappa0"], "b_init_Nm": v["b_init"],
+               "shear_scale": self.shear_scale,
+               "sigma_b_inf_Nm": s["b_inf"], "sigma_m0_N": s["m0"], "sigma_kappa0_per_m": s["kappa0"],
+               "sigma_b_init_Nm": s["b_init"], "sigma_shear_scale": s.get("shear_scale"),
+               "determined": self.determined, "loss_initial": self.loss_initial, "loss_final": self.loss_final,
+               "rms_mm_per_section": [1e3 * r for r in self.rms_per_section],
+               "rms_initial_mm_per_section": [1e3 * r for r in self.rms_initial_per_section],
+               "nrmse_per_section": self.nrmse_per_section, "kappa_reach_per_m": self.kappa_reach,
+               "gradient_check": self.gradient_check, "jacobian": self.jacobian, "iterations": self.iterations,
+               "forming_runs": self.forming_runs, "wall_time_s": self.wall_time, "converged": self.converged,
+               "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts]}
+        if self.profile_rmse is not None:
+            out["profile_rmse_mm"] = 1e3 * self.profile_rmse
+        return out
+
+
+class Progress(NamedTuple):
+    """What :func:`fit_wrinkles` hands its ``callback``: the stage and the best loss so far."""
+
+    stage: str  # "start", "gradient check", "global", "fit"
+    forming_runs: int
+    loss: float
+    q: tuple
+
+
+def voce_start(law) -> VoceBending:
+    """The Voce law a fit starts from: the case's (positive side of an asymmetric law; a linear law
+    ``B`` becomes ``B_init = B``, ``B_inf = B/2``, ``kappa0 = 20 1/m``)."""
+    if isinstance(law, AsymmetricBending):
+        law = law.pos
+    if isinstance(law, LinearBending):
+        b = float(law.b_init)
+        return VoceBending(b_inf=0.5 * b, m0=0.5 * b * 20.0, kappa0=20.0)
+    return law
+
+
+def scaled_shear(shear, s):
+    """The shear law with its force multiplied by ``s`` (the coefficient and force-knot leaves)."""
+    if dataclasses.is_dataclass(shear):
+        ch = {}
+        for f in dataclasses.fields(shear):
+            v = getattr(shear, f.name)
+            if f.name in ("coeffs", "force_knots"):
+                ch[f.name] = v * s
+            elif dataclasses.is_dataclass(v) or isinstance(v, tuple):
+                ch[f.name] = scaled_shear(v, s)
+        return dataclasses.replace(shear, **ch) if ch else shear
+    if isinstance(shear, tuple):
+        return tuple(scaled_shear(v, s) for v in shear)
+    return shear
+
+
+def imperfections(x0: np.ndarray, seeds: int, amplitude: float, blank_size: float) -> np.ndarray:
+    """(seeds, N, 3) out-of-plane blank imperfections: seed 0 none, the others a smooth random field
+    (8 Fourier modes of wavelength 1/4 to 1 blank) scaled to ``amplitude`` (m) at its largest."""
+    out = np.zeros((seeds,) + x0.shape)
+    for k in range(1, seeds):
+        rng = np.random.default_rng(k)
+        z = np.zeros(len(x0))
+        for _ in range(8):
+            kx, ky = rng.uniform(-4.0, 4.0, 2) * 2.0 * math.pi / blank_size
+            z += rng.normal() * np.cos(kx * x0[:, 0] + ky * x0[:, 1] + rng.uniform(0, 2 * math.pi))
+        out[k, :, 2] = amplitude * z / max(np.max(np.abs(z)), 1e-30)
+    return out
+
+
+class _Steps(NamedTuple):
+    """What :func:`jaxform.forming.rollout` reads of a run's info (hashable: a static argument)."""
+
+    n_frames: int
+    every: int
+
+
+def _member(q, dz, rig, lines, static):
+    """One forming run with the law ``q`` from the blank perturbed by ``dz``: ``(y, valid, ok, kappa_reach)``."""
+    kind, n_plies, steps, ns, checkpoint = static
+    model, state, fabric, ply_id, sel, faces = rig
+    q = q.astype(state.x.dtype)
+    law = law_from_q(q[:3], "voce")
+    fab = fabric.replace(bending=(law, law))
+    if kind == "voce+shear":
+        fab = fab.replace(shear=scaled_shear(fab.shear, jnp.exp(q[3])))
+    m = forming.with_fabric(model, fab)
+    st = dataclasses.replace(state, x=state.x + dz, u=state.u + dz.T)
+    s, _ = forming.rollout(m, st, steps, checkpoint=checkpoint)
+    dev = state_fields(m, s, ply_id, n_plies)["deviation"]
+    x, d = s.x[sel], dev[sel]
+    vals, oks = zip(*(sec_mod.simulated(x, faces, d, a, b, sq, n) for (a, b, sq), n in zip(lines, ns)))
+    y = jnp.concatenate(vals)
+    kappa = fibre_curvatures(s.x, m.shell.mesh, m.shell.ref)[sel]
+    reach = jnp.percentile(jnp.abs(kappa), KAPPA_PERCENTILE)
+    return y, jnp.concatenate(oks), (s.bad_step < 0) & jnp.all(jnp.isfinite(y)), reach
+
+
+@functools.partial(jax.jit, static_argnames=("static",))
+def _batch(Q, Z, rig, lines, static):
+    """:func:`_member` over a batch (one compiled program per rig shape, shared by every fit in a process)."""
+    return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static))(Q, Z)
+
+
+@functools.partial(jax.jit, static_argnames=("static",))
+def _grad(q, dz, rig, lines, R, meas, valid, static):
+    """Gradient of ``0.5 |R (y - meas)|^2`` (``y`` masked by ``valid``), checkpointed reverse mode."""
+    def loss(q):
+        r = R @ jnp.where(valid, _member(q, dz, rig, lines, static[:-1] + (True,))[0] - meas, 0.0)
+        return 0.5 * jnp.sum(r * r)
+
+    return jax.grad(loss)(q)
+
+
+class _Runs:
+    """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``."""
+
+    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply):
+        rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)))
+        model, state, info = rig
+        fab = model.shell.fabrics[0]
+        if fab.bending is None:
+            raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
+        if not 1 <= ply <= case.n_plies:
+            raise ValueError(f"fit_wrinkles: ply = {ply}: the case has plies 1..{case.n_plies}")
+        self.law0, self.width, self.seeds = voce_start(fab.bending[0]), int(width), int(seeds)
+        self.dtype = state.x.dtype
+        sel = np.asarray(info.ply_id) == ply
+        local = np.cumsum(sel) - 1
+        faces = local[info.faces[np.all(sel[info.faces], axis=1)]]
+        self.rig = (model, state, fab, jnp.asarray(info.ply_id), jnp.asarray(np.flatnonzero(sel)), jnp.asarray(faces))
+        self.lines = tuple((jnp.asarray(s.start, self.dtype), jnp.asarray(s.end, self.dtype), jnp.asarray(s.s, self.dtype))
+                           for s in sections)
+        ns = tuple(sec_mod.n_samples(s, case.element_size) for s in sections)
+        self.static = (param_kind, case.n_plies, _Steps(info.n_frames, info.every), ns, False)
+        self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size), self.dtype)
+        self.cache: dict = {}
+        self.runs = 0
+
+    def evaluate(self, qs: Sequence[np.ndarray]) -> list:
+        """``(y (M,), valid (M,), ok, kappa_reach)`` per ``q``, the mean over the seeds (host)."""
+        keys = [tuple(np.round(np.asarray(q, float), 12).tolist()) for q in qs]
+        todo = [k for k in dict.fromkeys(keys) if k not in self.cache]
+        members = [(k, i) for k in todo for i in range(self.seeds)]
+        out: dict = {}
+        for a in range(0, len(members), self.width):
+            chunk = members[a:a + self.width]
+            pad = chunk + [chunk[-1]] * (self.width - len(chunk))
+            Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
+            Z = self.dz[np.array([i for _, i in pad])]
+            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
+            self.runs += len(chunk)
+            for j, (k, _) in enumerate(chunk):
+                out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
+        for k, rs in out.items():
+            self.cache[k] = (np.mean([r[0] for r in rs], axis=0), np.all([r[1] for r in rs], axis=0),
+                             all(r[2] for r in rs), float(np.mean([r[3] for r in rs])))
+        return [self.cache[k] for k in keys]
+
+    def gradient_ad(self, q, R, meas, valid) -> np.ndarray:
+        """(p,) gradient of the section loss ``0.5 |R (y - meas)|^2`` by checkpointed reverse mode
+        through the whole run (one checkpoint per frame; the mean over the seeds)."""
+        args = (jnp.asarray(R, self.dtype), jnp.asarray(meas, self.dtype), jnp.asarray(valid))
+        g = [np.asarray(_grad(jnp.asarray(q, self.dtype), self.dz[i], self.rig, self.lines, *args, static=self.static), float)
+             for i in range(self.seeds)]
+        self.runs += self.seeds
+        return np.mean(g, axis=0)
+
+
+def _bounds(q0, kind):
+    lo = np.array([q0[0] - math.log(SPAN), math.log(1e-3), q0[2] - math.log(SPAN)])
+    hi = np.array([q0[0] + math.log(SPAN), 0.0, q0[2] + math.log(SPAN)])
+    if kind == "voce+shear":
+        lo, hi = np.append(lo, -math.log(SHEAR_SPAN)), np.append(hi, math.log(SHEAR_SPAN))
+    return lo, hi
+
+
+def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Sequence | None = None,
+                 areal_mass: float | None = None, noise: float = NOISE, profile_noise: float | None = None,
+                 smoothing: float | None = None, ply: int = 1, n_starts: int = 4, max_iter: int = 8,
+                 fd_step: float = FD_STEP, gradient_check: bool = True, seeds: int = 1,
+                 imperfection: float | None = None, batch_width: int | None = None,
+                 profile_kwargs: dict | None = None, callback: Callable[[Progress], Any] | None = None) -> WrinkleFit:
+    """Fit the bending law of ``case`` to measured wrinkle sections (module docstring).
+
+    Args:
+        case: a resolved :class:`~jaxform.forming.Case` (the rig, the mesh and the starting law).
+        sections: :class:`~jaxform.calibrate.sections.Section` list (m).
+        params: ``"voce"`` or ``"voce+shear"``.
+        profiles: cantilever :class:`~jaxform.calibrate.Profile` list of the same fabric (joint
+            fit; needs ``areal_mass``, kg/m²); ``profile_noise`` (m) default: read off the profiles.
+        noise: the sections' measurement noise, m.
+        smoothing: width of the residual's smoothing, m (default: the element size).
+        ply: the ply whose amplitude was measured (1 touches the punch).
+        n_starts: laws scored in the global phase (the starting law and moves around it).
+        max_iter: residual evaluations of the optimiser (``max_nfev``).
+        fd_step: log-space step of the finite differences.
+        gradient_check: compare AD with central differences at the start (else: FD Jacobian).
+        seeds: imperfect blanks averaged per evaluation (1: the perfect blank only).
+        imperfection: their amplitude, m (default a tenth of the ply thickness).
+        batch_width: members per compiled batch (default 1 on a CPU, ``2 p`` otherwise).
+        profile_kwargs: keyword arguments of the cantilever model (``jaxform.cantilever.simulate``).
+        callback: called with a :class:`Progress` at each stage and evaluation.
+    Returns:
+        :class:`WrinkleFit`; ``converged`` and ``reason`` say whether to use it.
+    """
+    t0 = time.perf_counter()
+    if params not in PARAM_KINDS:
+        raise ValueError(f"fit_wrinkles: params = {params!r}: must be one of {', '.join(PARAM_KINDS)}")
+    sections = list(sections)
+    if not sections:
+        raise ValueError("fit_wrinkles: no sections given")
+    for s in sections:
+        sec_mod.check_section(s, case)
+    for name, v, ok in (("noise", noise, noise > 0), ("fd_step", fd_step, 0 < fd_step < 1),
+                        ("seeds", seeds, int(seeds) >= 1), ("n_starts", n_starts, int(n_starts) >= 1),
+                        ("max_iter", max_iter, int(max_iter) >= 1), ("smoothing", smoothing, smoothing is None or smoothing >= 0)):
+        if not ok:
+            raise ValueError(f"fit_wrinkles: {name} = {v!r} is out of range")
+    if profiles and not (areal_mass and areal_mass > 0):
+        raise ValueError("fit_wrinkles: profiles need the fabric's areal_mass (kg/m² > 0)")
+    width = smoothing if smoothing is not None else float(case.element_size)
+    p = 3 if params == "voce" else 4
+    if batch_width is None:
+        batch_width = 1 if jax.default_backend() == "cpu" else 2 * p
+    imperfection = 0.1 * case.ply_thickness if imperfection is None else float(imperfection)
+    runs = _Runs(case, sections, params, int(seeds), imperfection, batch_width, ply)
+    Ws = [sec_mod.smoothing_matrix(s.s, width) for s in sections]
+    R = block_diag(*[W / sec_mod.row_scale(W, noise)[:, None] for W in Ws])  # (rows, M): y -> section rows
+    cuts = np.cumsum([0] + [len(s.s) for s in sections])
+    meas = np.concatenate([s.amplitude for s in sections])
+    prof = pn = None
+    if profiles:
+        prof = ProfileModel(list(profiles), "voce", cantilever.simulate, dict(profile_kwargs or {}), areal_mass, 1e-5,
+                            jnp.result_type(float))
+        pn = profile_noise if profile_noise is not None else float(np.sqrt(np.mean(
+            [estimate_noise(pr.x, pr.z) ** 2 for pr in prof.profiles])))
+    n_rows = len(meas) + _n_prof(prof)
+    q0 = np.append(q_from_law(runs.law0, "voce"), [0.0] * (p - 3))
+    lo, hi = _bounds(q0, params)
+    best = {"loss": math.inf, "q": q0}
+
+    def report(stage, q, value):
+        if value < best["loss"]:
+            best.update(loss=value, q=np.asarray(q, float))
+        if callback is not None:
+            callback(Progress(stage, runs.runs, best["loss"], tuple(best["q"].tolist())))
+
+    def rows(q, stage="fit"):
+        y, valid, ok, _ = runs.evaluate([q])[0]
+        r = [R @ np.where(valid, y - meas, 0.0)] + ([prof.rows(q[:3]) * 1e-3 / pn] if prof is not None else [])
+        r = np.concatenate(r)
+        if not (ok and np.all(np.isfinite(r))):
+            return np.full(n_rows, np.inf)
+        report(stage, q, 0.5 * float(r @ r))
+        return r
+
+    def loss(q, stage="fit"):
+        r = rows(q, stage)
+        return 0.5 * float(r @ r)
+
+    def prof_jac(q):
+        return prof.jac(q[:3]) * 1e-3 / pn
+
+    def grad_ad(q):
+        """AD gradient of the loss: the sections' by reverse mode through the run, the profiles' exact."""
+        g = runs.gradient_ad(q, R, meas, runs.evaluate([q])[0][1])
+        if prof is not None:
+            g[:3] += prof_jac(q).T @ (prof.rows(q[:3]) * 1e-3 / pn)
+        return g
+
+    def fd_jac(q):
+        q = np.asarray(q, float)
+        steps = [fd_step if q[i] + fd_step <= hi[i] else -fd_step for i in range(p)]
+        pts = [q + h * e for h, e in zip(steps, np.eye(p))]
+        runs.evaluate([q] + pts)  # one batch
+        r0 = rows(q)
+        return np.stack([(rows(x) - r0) / h for x, h in zip(pts, steps)], axis=1)
+
+    # the starting law: the case's rig must produce every section
+    ev0 = runs.evaluate([q0])[0]
+    if not ev0[2]:
+        raise RuntimeError(f"fit_wrinkles: the forming run with the starting law failed (non-finite or blown up); "
+                           f"case {case.name!r} does not run as given")
+    for s, a, b in zip(sections, cuts[:-1], cuts[1:]):
+        off = 1.0 - float(np.mean(ev0[1][a:b]))
+        if off > sec_mod.MAX_OFF_PART:
+            raise ValueError(f"section {s.name or '?'}: {100 * off:.0f} % of its points lie off the part formed with the "
+                             f"starting law (more than {100 * sec_mod.MAX_OFF_PART:.0f} %); the rig of case "
+                             f"{case.name!r} cannot produce this section (it draws the blank in past it)")
+    loss0 = loss(q0, "start")
+
+    # (1) the gradient check and (2) the safeguard
+    check: dict = {"done": False}
+    mode = "fd"
+    if gradient_check:
+        g_ad = grad_ad(q0)
+        runs.evaluate([q0 + s * fd_step * e for e in np.eye(p) for s in (1.0, -1.0)])
+        g_fd = np.array([(loss(q0 + fd_step * e, "gradient check") - loss(q0 - fd_step * e, "gradient check"))
+                         / (2 * fd_step) for e in np.eye(p)])
+        agree = bool(np.all(np.isfinite(g_ad)) and np.all(np.abs(g_ad - g_fd) <= GRAD_RTOL * np.abs(g_fd)))
+        mode = "ad" if agree else "fd"
+        check = {"done": True, "parameters": list(NAMES[:p]), "ad": g_ad.tolist(), "fd": g_fd.tolist(),
+                 "fd_step": fd_step, "rel_error": (np.abs(g_ad - g_fd) / np.maximum(np.abs(g_fd), 1e-300)).tolist(),
+                 "agree": agree,
+                 "action": ("the fit follows the AD gradient (L-BFGS-B)" if agree else
+                            f"AD disagrees with central differences over a log step of {fd_step:g} (the run is "
+                            "chaotically sensitive to the law): the fit uses Gauss-Newton with a forward-difference "
+                            "Jacobian of that step instead")}
+
+    # (3) the global phase: the best of a few laws around the starting one
+    cands = [q0] + [np.clip(q0 + np.append(m, [0.0] * (p - 3)), lo, hi) for m in _START_MOVES][: int(n_starts) - 1]
+    runs.evaluate(cands)
+    starts = [(c, loss(c, "global")) for c in cands]
+    x0 = np.clip(min(starts, key=lambda t: t[1])[0], lo + 1e-9, hi - 1e-9)
+    # (4) the gradient phase
+    if mode == "ad":
+        opt = minimize(lambda q: (loss(q), grad_ad(q)), x0, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
+                       options={"maxfun": int(max_iter)})
+        opt.ok = bool(opt.success)
+    else:
+        opt = least_squares(rows, x0, jac=fd_jac, bounds=(lo, hi), method="trf", max_nfev=int(max_iter), x_scale=1.0,
+                            ftol=1e-3, xtol=1e-3, gtol=1e-8)
+        opt.ok = bool(opt.status > 0)
+    q = np.asarray(best["q"], float)  # the best law seen (a finite-difference step may have found a lower loss)
+    r = rows(q)
+    J = fd_jac(q)
+    return _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi,
+                      starts, q0, time.perf_counter() - t0)
+
+
+def _n_prof(prof) -> int:
+    return 0 if prof is None else sum(len(pr.x) for pr in prof.profiles)
+
+
+def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi, starts, q0,
+               wall) -> WrinkleFit:
+    p = len(q)
+    y, valid, ok, reach = runs.evaluate([q])[0]
+    y0 = runs.evaluate([q0])[0][0]
+    n_sec = int(cuts[-1])
+    n_ind = sum(sec_mod.independent_points(s, width) for s in sections)
+    n_eff = n_ind + _n_prof(prof)
+    chi2 = float(r @ r)
+    c = max(1.0, chi2 / max(n_eff - p, 1)) * (n_sec + _n_prof(prof)) / n_eff
+    cov = c * np.linalg.pinv(J.T @ J)
+    dtype = jnp.result_type(float)
+    phys = np.asarray(_physical(jnp.asarray(q[:3], dtype), "voce"), float)
+    T = np.asarray(jax.jacfwd(lambda v: _physical(v, "voce"))(jnp.asarray(q[:3], dtype)), float)
+    sig = np.sqrt(np.clip(np.diag(T @ cov[:3, :3] @ T.T), 0.0, None))
+    keys = ("b_inf", "m0", "kappa0", "b_init")
+    values = dict(zip(keys, map(float, phys)))
+    sigma = dict(zip(keys, map(float, sig)))
+    shear = float(math.exp(q[3])) if p == 4 else 1.0
+    if p == 4:
+        sigma["shear_scale"] = float(shear * math.sqrt(max(cov[3, 3], 0.0)))
+    determined = {k: bool(sigma[k] < DETERMINED_SD * abs(values[k])) for k in sigma}
+    fitted = [y[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
+    init = [y0[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
+    rms = [float(np.sqrt(np.mean((f - s.amplitude) ** 2))) for f, s in zip(fitted, sections)]
+    rms0 = [float(np.sqrt(np.mean((f - s.amplitude) ** 2))) for f, s in zip(init, sections)]
+    nrmse = [float(section_nrmse(s.s, s.amplitude, s.s, f, None, valid[a:b]))
+             for f, s, a, b in zip(fitted, sections, cuts[:-1], cuts[1:])]
+    gn = float("inf")
+    if np.all(np.isfinite(J)):
+        d = lsq_linear(J, -r, bounds=(lo - q, hi - q)).x
+        gn = float(chi2 - np.sum((r + J @ d) ** 2))
+    converged = bool(opt.ok or gn < GN_TOL)
+    loss = 0.5 * chi2
+    reasons = []
+    if not converged:
+        reasons.append(f"the optimiser ({mode}) ran out of evaluations ({opt.nfev}) with a Gauss-Newton step still "
+                       f"removing {gn:.3g} of the chi-square")
+    if not loss < loss0:
+        reasons.append("no law lowered the loss below the starting law's")
+    at = [NAMES[i] for i in range(p) if q[i] <= lo[i] + 1e-6 or (q[i] >= hi[i] - 1e-6 and i != 1)]
+    if at:
+        reasons.append(f"{', '.join(at)} at the search bound")
+    return WrinkleFit(
+        law=law_from_q(jnp.asarray(q[:3], dtype), "voce"), law_initial=runs.law0, shear_scale=shear, q=q, values=values, sigma=sigma,
+        determined=determined, loss_initial=loss0, loss_final=loss, rms_per_section=rms, rms_initial_per_section=rms0,
+        nrmse_per_section=nrmse, profile_rmse=(float(np.sqrt(np.mean((prof.rows(q[:3]) * 1e-3) ** 2)))
+                                               if prof is not None else None),
+        kappa_reach=reach, gradient_check=check, jacobian=mode, iterations=int(opt.get("njev") or opt.get("nit") or 0), forming_runs=runs.runs,
+        wall_time=wall, converged=converged and not reasons, reason="; ".join(reasons),
+        starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov)
+
+
+__all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",
+           "NOISE", "FD_STEP", "GRAD_RTOL"]

@@ -65,6 +65,7 @@ GRAD_RTOL = 0.3  # AD agrees with central differences where |g_ad - g_fd| <= GRA
 SPAN = 10.0  # B_init and kappa0 are searched within this factor of the starting law
 SHEAR_SPAN = 3.0
 DETERMINED_SD = 0.10
+CHI_LIMIT = 3.0  # a fit is usable only where its residual rows' RMS is at most this many noise sds
 GRAD_FRAMES = 21  # the fit's rig has this many frames: one checkpoint each in the reverse pass
 KAPPA_PERCENTILE = 98.0  # "the curvatures the wrinkles reach": this percentile of |kappa| on the fitted part
 NAMES = ("B_init", "B_inf/B_init", "kappa0", "shear scale")
@@ -479,6 +480,10 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     at = [NAMES[i] for i in range(p) if q[i] <= lo[i] + 1e-6 or (q[i] >= hi[i] - 1e-6 and i != 1)]
     if at:
         reasons.append(f"{', '.join(at)} at the search bound")
+    chi_rms = math.sqrt(chi2 / max(len(r), 1))
+    if not chi_rms <= CHI_LIMIT:
+        reasons.append(f"the fitted sections miss the data by {chi_rms:.3g} noise sds RMS (smoothed rows; limit "
+                       f"{CHI_LIMIT:g}): no law of this form reproduces them on this mesh, or the noise given is too small")
     return WrinkleFit(
         law=law_from_q(jnp.asarray(q[:3], dtype), "voce"), law_initial=runs.law0, shear_scale=shear, q=q, values=values, sigma=sigma,
         determined=determined, loss_initial=loss0, loss_final=loss, rms_per_section=rms, rms_initial_per_section=rms0,

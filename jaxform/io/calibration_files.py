@@ -161,12 +161,17 @@ def read_profile_csv(path, overhang: float | None = None):
 
 def write_profile_csv(path, x, z, *, force: bool = False) -> pathlib.Path:
     """Write a profile (x, z in m) as ``x_mm,z_mm``; refuses to overwrite unless ``force``."""
+    return _write_mm_columns(path, ("x_mm", "z_mm"), x, z, force)
+
+
+def _write_mm_columns(path, header, a, b, force: bool) -> pathlib.Path:
+    """Two columns given in m written in mm under ``header``; refuses to overwrite unless ``force``."""
     path = _check_new(path, force)
     with path.open("w", newline="") as fh:
         wr = csv.writer(fh)
-        wr.writerow(["x_mm", "z_mm"])
-        for a, b in zip(np.asarray(x) * 1e3, np.asarray(z) * 1e3):
-            wr.writerow([f"{a:.6f}", f"{b:.6f}"])
+        wr.writerow(list(header))
+        for u, v in zip(np.asarray(a) * 1e3, np.asarray(b) * 1e3):
+            wr.writerow([f"{u:.6f}", f"{v:.6f}"])
     return path
 
 
@@ -395,13 +400,7 @@ def read_section_csv(path, start, end):
 
 def write_section_csv(path, s, amplitude, *, force: bool = False) -> pathlib.Path:
     """Write a section (s, amplitude in m) as ``s_mm,amplitude_mm``; refuses to overwrite unless ``force``."""
-    path = _check_new(path, force)
-    with path.open("w", newline="") as fh:
-        wr = csv.writer(fh)
-        wr.writerow(["s_mm", "amplitude_mm"])
-        for u, v in zip(np.asarray(s) * 1e3, np.asarray(amplitude) * 1e3):
-            wr.writerow([f"{u:.6f}", f"{v:.6f}"])
-    return path
+    return _write_mm_columns(path, ("s_mm", "amplitude_mm"), s, amplitude, force)
 
 
 __all__ = ["read_profile_csv", "read_section_csv", "write_section_csv", "parse_line_mm", "write_profile_csv", "read_shear_csv", "write_json", "shear_toml",

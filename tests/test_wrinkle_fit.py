@@ -1,0 +1,139 @@
+"""Wrinkle sections and the fit of the bending law from them (issue 16): the data's edge checks,
+the position-tolerant residual, the pieces of the fit, and the script's refusals. The fit itself
+runs end to end in notebook 07's test and in ``benchmarks/bench_wrinkle_fit.py``."""
+import math
+import re
+
+import numpy as np
+import pytest
+
+from jaxform import cases
+from jaxform.calibrate import sections as S
+from jaxform.calibrate import wrinkle_fit as wf
+from jaxform.io import calibration_files as cf
+from jaxform.materials import LinearBending, PolynomialShear, VoceBending, preset
+from helpers import run_calibration_script
+
+CASE = cases.resolve("case-a-woven-nlbm", element_size=25e-3)
+
+
+def _section(s_mm=None, a_mm=None, line_mm=(60.0, 60.0, 120.0, 120.0), name="A"):
+    s_mm = np.linspace(0.0, 80.0, 41) if s_mm is None else np.asarray(s_mm, float)
+    a_mm = np.zeros_like(s_mm) if a_mm is None else np.asarray(a_mm, float)
+    line = np.asarray(line_mm, float) * 1e-3
+    return S.Section(s_mm * 1e-3, a_mm * 1e-3, line[:2], line[2:], name)
+
+
+@pytest.mark.parametrize("kwargs,match", [
+    (dict(line_mm=(0.06, 0.06, 0.12, 0.12), s_mm=np.linspace(0, 0.08, 9)), r"line is 0.0849 mm long .* in metres"),
+    (dict(line_mm=(60.0, 60.0, 160.0, 160.0), s_mm=np.linspace(0.0, 140.0, 29)), r"outside the 250 mm square blank"),
+    (dict(s_mm=np.linspace(0.0, 150.0, 20)), r"positions run from 0 to 150 mm, off the 84.85 mm line"),
+    (dict(s_mm=[0.0, 1.0, 2.0]), r"need at least 5"),
+    (dict(a_mm=np.full(41, 1e4)), r"amplitudes up to 1e\+04 mm, more than the 250 mm blank"),
+])
+def test_check_section_refuses(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        S.check_section(_section(**kwargs), CASE)
+
+
+def test_check_section_accepts_a_line_on_the_blank():
+    S.check_section(_section(), CASE)
+
+
+def test_smoothing_tolerates_a_shifted_wrinkle():
+    """A 3 mm crest moved by 2 mm: after smoothing over 8 mm its residual is a third of the raw one or
+    less, and the smoothed crest still stands out against no wrinkle at all (the signal is kept)."""
+    s = np.linspace(0.0, 0.1, 201)
+    crest = lambda c: 3e-3 * np.exp(-0.5 * ((s - c) / 3e-3) ** 2)  # noqa: E731
+    W = S.smoothing_matrix(s, 8e-3)
+    assert np.allclose(W.sum(axis=1), 1.0)
+    raw = np.sqrt(np.mean((crest(0.052) - crest(0.05)) ** 2))
+    smooth = np.sqrt(np.mean((W @ (crest(0.052) - crest(0.05))) ** 2))
+    signal = np.sqrt(np.mean((W @ crest(0.05)) ** 2))
+    assert smooth < raw / 3.0
+    assert signal > 5.0 * smooth
+    assert np.allclose(S.smoothing_matrix(s, 0.0), np.eye(s.size))
+    # a row's noise after smoothing: sigma * sqrt(sum W^2), below sigma
+    rs = S.row_scale(W, 5e-5)
+    assert np.all(rs < 5e-5) and np.all(rs > 5e-5 / np.sqrt(s.size))
+
+
+def test_read_section_csv(tmp_path):
+    p = tmp_path / "a.csv"
+    p.write_text("s_mm,amplitude_mm\n2,0.5\n0,0.1\n1,0.3\n1,0.5\n3,0.2\n4,0.1\n5,0\n")
+    sec = cf.read_section_csv(p, np.zeros(2), np.array([0.05, 0.0]))
+    assert np.allclose(sec.s, np.arange(6) * 1e-3) and math.isclose(sec.amplitude[1], 0.4e-3)
+    p.write_text("s,amp\n1,2\n")
+    with pytest.raises(ValueError, match="must have columns s_mm,amplitude_mm"):
+        cf.read_section_csv(p, np.zeros(2), np.ones(2))
+    p.write_text("s_mm,amplitude_mm\n0,1\n1,\n2,1\n3,1\n4,1\n5,x\n")
+    with pytest.raises(ValueError, match="not a number"):
+        cf.read_section_csv(p, np.zeros(2), np.ones(2))
+    out = cf.write_section_csv(tmp_path / "b.csv", sec.s, sec.amplitude)
+    back = cf.read_section_csv(out, sec.start, sec.end)
+    assert np.allclose(back.amplitude, sec.amplitude)
+    with pytest.raises(FileExistsError):
+        cf.write_section_csv(out, sec.s, sec.amplitude)
+
+
+@pytest.mark.parametrize("text", ["1,2,3", "a,b,c,d", "1,2,3,nan"])
+def test_parse_line_refuses(text):
+    with pytest.raises(ValueError, match="four numbers X0,Y0,X1,Y1 in mm"):
+        cf.parse_line_mm(text)
+
+
+def test_scaled_shear_scales_the_force_of_both_fabrics():
+    g = np.linspace(-0.8, 0.8, 17)
+    for shear in (PolynomialShear([1.0, 2.0, 3.0]), preset("ncf-fcim359").shear):
+        assert np.allclose(np.asarray(wf.scaled_shear(shear, 2.5).force(g)), 2.5 * np.asarray(shear.force(g)))
+
+
+def test_voce_start_and_imperfections():
+    lin = wf.voce_start(LinearBending(4e-4))
+    assert isinstance(lin, VoceBending) and math.isclose(float(lin.b_init), 4e-4)
+    x0 = np.stack(np.meshgrid(np.linspace(-0.1, 0.1, 11), np.linspace(-0.1, 0.1, 11)), -1).reshape(-1, 2)
+    x0 = np.concatenate([x0, np.zeros((len(x0), 1))], 1)
+    dz = wf.imperfections(x0, 3, 2e-5, 0.2)
+    assert np.all(dz[0] == 0) and np.all(dz[:, :, :2] == 0)
+    assert np.allclose(np.abs(dz[1:, :, 2]).max(axis=1), 2e-5)
+    assert not np.allclose(dz[1], dz[2])
+
+
+def _cli(argv, capsys):
+    return run_calibration_script("fit_wrinkles", argv, capsys)
+
+
+def _csv(path, s_mm, a_mm):
+    path.write_text("s_mm,amplitude_mm\n" + "\n".join(f"{u},{v}" for u, v in zip(s_mm, a_mm)) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("extra,match", [
+    (["--line", "0.06,0.06,0.12,0.12"], r"line is .* mm long .* in metres"),
+    (["--line", "100,100,200,200"], r"outside the 250 mm square blank"),
+    (["--line", "60,60"], r"four numbers X0,Y0,X1,Y1"),
+    (["--line", "60,60,120,120", "--set", "fabric.nope=1"], r"fabric.nope"),
+])
+def test_fit_wrinkles_script_refuses_input(tmp_path, capsys, extra, match):
+    sec = _csv(tmp_path / "a.csv", np.linspace(0, 80, 21), np.zeros(21))
+    out = tmp_path / "params.json"
+    rc, _, err = _cli(["--case", "case-a-woven-nlbm", "--section", sec, *extra, "--out", out], capsys)
+    assert rc == 2, err
+    assert re.search(match, err), err
+    assert not out.exists()
+
+
+def test_fit_wrinkles_script_refuses_before_running(tmp_path, capsys):
+    sec = _csv(tmp_path / "a.csv", np.linspace(0, 80, 21), np.zeros(21))
+    out = tmp_path / "params.json"
+    out.write_text("{}")
+    rc, _, err = _cli(["--case", "case-a-woven-nlbm", "--section", sec, "--line", "60,60,120,120", "--out", out], capsys)
+    assert rc == 2 and "exists; refusing to overwrite" in err and out.read_text() == "{}"
+    rc, _, err = _cli(["--case", "case-a-woven-nlbm", "--section", sec, "--out", tmp_path / "p.json"], capsys)
+    assert rc == 2 and "give one line" in err
+    rc, _, err = _cli(["--case", "case-a-woven-nlbm", "--section", sec, "--line", "60,60,120,120", "--profile", sec,
+                       "--overhang-mm", "90", "--out", tmp_path / "p.json"], capsys)
+    assert rc == 2 and "--areal-mass-gsm" in err
+
+
+

@@ -22,6 +22,7 @@ import math
 
 import jax.numpy as jnp
 import numpy as np
+from scipy.linalg import block_diag
 
 from jaxform.metrics.wrinkles import section_profile
 
@@ -110,6 +111,12 @@ def row_scale(W: np.ndarray, noise: float) -> np.ndarray:
     return noise * np.sqrt(np.sum(W * W, axis=1))
 
 
+def weights(sections, noise: float, width: float) -> np.ndarray:
+    """(rows, M) the residual's map from the stacked section values (m) to smoothed rows in noise sds."""
+    Ws = [smoothing_matrix(s.s, width) for s in sections]
+    return block_diag(*[W / row_scale(W, noise)[:, None] for W in Ws])
+
+
 def independent_points(sec: Section, width: float) -> float:
     """About how many independent residuals the smoothed section holds (``length / (2 sqrt(pi) w)``, at most m)."""
     if width <= 0:
@@ -139,5 +146,5 @@ def simulated(nodes, faces, deviation, start, end, s, n: int):
     return jnp.where(ok, val, 0.0), ok
 
 
-__all__ = ["Section", "check_section", "smoothing_matrix", "row_scale", "independent_points", "n_samples",
+__all__ = ["Section", "check_section", "smoothing_matrix", "row_scale", "weights", "independent_points", "n_samples",
            "simulated", "MIN_LINE", "MAX_OFF_PART"]

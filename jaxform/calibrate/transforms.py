@@ -1,4 +1,5 @@
-"""Parameters of the bending laws a cantilever fit varies, and the similarity of hanging strips.
+"""Parameters of the bending laws the fits vary, the similarity of hanging strips, and the laws a
+wrinkle fit starts from and scales (:func:`voce_start`, :func:`scaled_shear`).
 
 ``q = (log B_init, log(b_inf / B_init), log kappa0)`` for the Voce law: ``B_init`` (what a profile
 determines best), the softening ratio ``B_inf / B_init`` in (0, 1] and the curvature scale. Every
@@ -14,12 +15,13 @@ gives that law, so a fit solves every overhang on one strip (one compile).
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import jax.numpy as jnp
 import numpy as np
 
-from jaxform.materials import LinearBending, VoceBending
+from jaxform.materials import AsymmetricBending, LinearBending, VoceBending
 
 LAW_KINDS = ("voce", "linear")
 
@@ -51,4 +53,33 @@ def _physical(q, law_kind: str):
     return jnp.stack([law.b_inf, law.m0, law.kappa0, law.b_inf + law.m0 / law.kappa0])
 
 
-__all__ = ["LAW_KINDS", "law_from_q", "q_from_law"]
+
+
+def voce_start(law) -> VoceBending:
+    """The Voce law a fit starts from: the case's (positive side of an asymmetric law; a linear law
+    ``B`` becomes ``B_init = B``, ``B_inf = B/2``, ``kappa0 = 20 1/m``)."""
+    if isinstance(law, AsymmetricBending):
+        law = law.pos
+    if isinstance(law, LinearBending):
+        b = float(law.b_init)
+        return VoceBending(b_inf=0.5 * b, m0=0.5 * b * 20.0, kappa0=20.0)
+    return law
+
+
+def scaled_shear(shear, s):
+    """The shear law with its force multiplied by ``s`` (the coefficient and force-knot leaves)."""
+    if dataclasses.is_dataclass(shear):
+        ch = {}
+        for f in dataclasses.fields(shear):
+            v = getattr(shear, f.name)
+            if f.name in ("coeffs", "force_knots"):
+                ch[f.name] = v * s
+            elif dataclasses.is_dataclass(v) or isinstance(v, tuple):
+                ch[f.name] = scaled_shear(v, s)
+        return dataclasses.replace(shear, **ch) if ch else shear
+    if isinstance(shear, tuple):
+        return tuple(scaled_shear(v, s) for v in shear)
+    return shear
+
+
+__all__ = ["LAW_KINDS", "law_from_q", "q_from_law", "voce_start", "scaled_shear"]

@@ -11,7 +11,8 @@ Residual: per section, the Gaussian-smoothed difference of simulated and measure
 units of the smoothed noise (:mod:`jaxform.calibrate.sections`: tolerant of small wrinkle shifts),
 and with profiles the cantilever fit's z-residuals in units of their noise. The forming rig is
 built once; each trial law is one ``forming.rollout`` of the whole stroke (members of a batch of
-fixed width: 1 on a CPU, where a vmapped batch is no faster per member; more on an accelerator).
+fixed width: 1 on a CPU, run unbatched, because under ``vmap`` every ``lax.cond`` of the contact
+searches runs both branches (measured: 206 s against 4.9 s per 16 mm run); more on an accelerator).
 
 Why not plain gradients. Reverse or forward mode through the run is exact (the README: it equals
 central differences at ``h = 1e-8``) but the buckled flange is chaotically sensitive to the law:
@@ -45,17 +46,15 @@ from typing import Any, Callable, NamedTuple, Sequence
 import jax
 import jax.numpy as jnp
 import numpy as np
-from scipy.linalg import block_diag
 from scipy.optimize import least_squares, lsq_linear, minimize
 
 from jaxform import cantilever, forming
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
-from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law
+from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
 from jaxform.forming.fields import state_fields
 from jaxform.metrics import section_nrmse
-from jaxform.materials import AsymmetricBending, LinearBending, VoceBending
 from jaxform.shell import fibre_curvatures
 
 PARAM_KINDS = ("voce", "voce+shear")
@@ -131,33 +130,6 @@ class Progress(NamedTuple):
     q: tuple
 
 
-def voce_start(law) -> VoceBending:
-    """The Voce law a fit starts from: the case's (positive side of an asymmetric law; a linear law
-    ``B`` becomes ``B_init = B``, ``B_inf = B/2``, ``kappa0 = 20 1/m``)."""
-    if isinstance(law, AsymmetricBending):
-        law = law.pos
-    if isinstance(law, LinearBending):
-        b = float(law.b_init)
-        return VoceBending(b_inf=0.5 * b, m0=0.5 * b * 20.0, kappa0=20.0)
-    return law
-
-
-def scaled_shear(shear, s):
-    """The shear law with its force multiplied by ``s`` (the coefficient and force-knot leaves)."""
-    if dataclasses.is_dataclass(shear):
-        ch = {}
-        for f in dataclasses.fields(shear):
-            v = getattr(shear, f.name)
-            if f.name in ("coeffs", "force_knots"):
-                ch[f.name] = v * s
-            elif dataclasses.is_dataclass(v) or isinstance(v, tuple):
-                ch[f.name] = scaled_shear(v, s)
-        return dataclasses.replace(shear, **ch) if ch else shear
-    if isinstance(shear, tuple):
-        return tuple(scaled_shear(v, s) for v in shear)
-    return shear
-
-
 def imperfections(x0: np.ndarray, seeds: int, amplitude: float, blank_size: float) -> np.ndarray:
     """(seeds, N, 3) out-of-plane blank imperfections: seed 0 none, the others a smooth random field
     (8 Fourier modes of wavelength 1/4 to 1 blank) scaled to ``amplitude`` (m) at its largest."""
@@ -206,6 +178,9 @@ def _batch(Q, Z, rig, lines, static):
     return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static))(Q, Z)
 
 
+_single = jax.jit(_member, static_argnames=("static",))
+
+
 @functools.partial(jax.jit, static_argnames=("static",))
 def _grad(q, dz, rig, lines, R, meas, valid, static):
     """Gradient of ``0.5 |R (y - meas)|^2`` (``y`` masked by ``valid``), checkpointed reverse mode."""
@@ -252,7 +227,11 @@ class _Runs:
             pad = chunk + [chunk[-1]] * (self.width - len(chunk))
             Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
             Z = self.dz[np.array([i for _, i in pad])]
-            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
+            if self.width == 1:  # unbatched: under vmap every lax.cond of the contact searches runs both branches
+                res = _single(Q[0], Z[0], self.rig, self.lines, self.static)
+                y, v, ok, reach = (np.asarray(t)[None] for t in res)
+            else:
+                y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
             self.runs += len(chunk)
             for j, (k, _) in enumerate(chunk):
                 out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
@@ -269,6 +248,53 @@ class _Runs:
              for i in range(self.seeds)]
         self.runs += self.seeds
         return np.mean(g, axis=0)
+
+
+def predict_sections(case, sections: Sequence, law=None, *, shear_scale: float = 1.0, ply: int = 1) -> list:
+    """The amplitude d_P (m) the forming run of ``case`` with ``law`` (default the case's) gives at each
+    section's points (the fit's own program): ``[(y (m,), valid (m,)), ...]``; a held-out check."""
+    kind = "voce" if shear_scale == 1.0 else "voce+shear"
+    for s in sections:
+        sec_mod.check_section(s, case)
+    runs = _Runs(case, sections, kind, 1, 0.0, 1, ply)
+    q = np.append(q_from_law(voce_start(law) if law is not None else runs.law0, "voce"),
+                  [] if kind == "voce" else [math.log(shear_scale)])
+    y, valid, ok, _ = runs.evaluate([q])[0]
+    if not ok:
+        raise RuntimeError(f"predict_sections: the forming run of case {case.name!r} with this law failed")
+    cuts = np.cumsum([0] + [len(s.s) for s in sections])
+    return [(y[a:b], valid[a:b]) for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+def sections_of(case, lines: dict, law=None, *, spacing: float = 1e-3, ply: int = 1) -> list:
+    """The sections ``{name: ((x0, y0), (x1, y1))}`` (m, top view) of the part ``case`` forms with
+    ``law`` (default the case's): a point every ``spacing`` m, those on the part, d_P as amplitude."""
+    raw = []
+    for name, (a, b) in lines.items():
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        n = int(round(float(np.linalg.norm(b - a)) / spacing)) + 1
+        raw.append(sec_mod.Section(s=np.linspace(0.0, np.linalg.norm(b - a), n), amplitude=np.zeros(n), start=a, end=b,
+                                   name=name))
+    return [dataclasses.replace(s, s=s.s[np.asarray(v, bool)], amplitude=np.asarray(y, float)[np.asarray(v, bool)])
+            for s, (y, v) in zip(raw, predict_sections(case, raw, law, ply=ply))]
+
+
+def section_loss(case, sections: Sequence, qs, *, noise: float = NOISE, smoothing: float | None = None, ply: int = 1,
+                 gradient_at: Sequence[int] = ()) -> tuple[np.ndarray, dict]:
+    """The fit's section loss ``0.5 |R (y - meas)|^2`` at each log-space law ``qs`` (k, 3)
+    (:func:`~jaxform.calibrate.transforms.q_from_law`) and its AD gradient (checkpointed reverse mode
+    through the run) at the indices ``gradient_at``: ``(losses (k,), {i: (3,)})``; ``inf`` where a
+    run fails. The loss along a line in parameter space shows how rough the landscape is."""
+    for s in sections:
+        sec_mod.check_section(s, case)
+    runs = _Runs(case, sections, "voce", 1, 0.0, 1, ply)
+    R = sec_mod.weights(sections, noise, smoothing if smoothing is not None else float(case.element_size))
+    meas = np.concatenate([s.amplitude for s in sections])
+    qs = [np.asarray(q, float) for q in qs]
+    evs = runs.evaluate(qs)
+    losses = np.array([0.5 * float(np.sum((R @ np.where(v, y - meas, 0.0)) ** 2)) if ok else np.inf
+                       for y, v, ok, _ in evs])
+    return losses, {i: runs.gradient_ad(qs[i], R, meas, evs[i][1]) for i in gradient_at}
 
 
 def _bounds(q0, kind):
@@ -329,8 +355,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         batch_width = 1 if jax.default_backend() == "cpu" else 2 * p
     imperfection = 0.1 * case.ply_thickness if imperfection is None else float(imperfection)
     runs = _Runs(case, sections, params, int(seeds), imperfection, batch_width, ply)
-    Ws = [sec_mod.smoothing_matrix(s.s, width) for s in sections]
-    R = block_diag(*[W / sec_mod.row_scale(W, noise)[:, None] for W in Ws])  # (rows, M): y -> section rows
+    R = sec_mod.weights(sections, noise, width)  # (rows, M): y -> section rows
     cuts = np.cumsum([0] + [len(s.s) for s in sections])
     meas = np.concatenate([s.amplitude for s in sections])
     prof = pn = None
@@ -494,5 +519,5 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
         starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov)
 
 
-__all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",
+__all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "predict_sections", "sections_of", "section_loss", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",
            "NOISE", "FD_STEP", "GRAD_RTOL"]

@@ -1,11 +1,10 @@
-"""Figures of the calibration fits (host side, matplotlib Agg)."""
+"""Figures of the calibration fits (host side). The backend is the session's: importing this module
+never switches it (a notebook keeps showing figures inline; a script without a display gets
+matplotlib's own fallback, Agg)."""
 from __future__ import annotations
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
 
 def cantilever_fit_figure(fit, profiles, *, title: str = ""):

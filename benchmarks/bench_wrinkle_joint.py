@@ -1,0 +1,72 @@
+"""Benchmark: the joint fit of issue 16 (done-when 3): cantilever profiles and wrinkle sections of one
+hidden law.
+
+``run(quick)``: the round trip's hidden law, case, sections and noise (:mod:`bench_wrinkle_fit`)
+plus one cantilever side profile of the same law from the independent reference elastica
+(``tests/reference/elastica.py``, numpy/scipy only): 300 g/m², overhang 80 mm, 60 points, 0.05 mm
+Gaussian noise on z. :func:`jaxform.calibrate.fit_wrinkles` with ``profiles`` (the fit's defaults)
+from the woven preset law. Reported: B_init's error and standard deviation; the moment's largest
+relative error over ``kappa_reach / 2 <= kappa <= kappa_reach`` (the high curvatures the wrinkles
+reach) and over ``0 < kappa <= kappa_reach``; the profile's RMS; the sections' RMS; wall time and
+forming runs. The issue's targets: B_init within 3 %, the high-curvature moment within 15 %.
+``quick``: 16 mm, two starts, two evaluations, no gradient check.
+"""
+from __future__ import annotations
+
+import dataclasses
+import importlib.util
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+HERE = pathlib.Path(__file__).resolve().parent
+_spec = importlib.util.spec_from_file_location("bench_wrinkle_fit", HERE / "bench_wrinkle_fit.py")
+_bw = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(_bw)
+
+MASS, OVERHANG, N_POINTS = 0.30, 0.080, 60
+
+
+def _profile(rng):
+    sys.path.insert(0, str(HERE.parent / "tests"))
+    from reference import elastica as E
+
+    b_inf, m0, kappa0 = _bw.TRUTH
+    ref = E.solve_cantilever(E.voce_moment(b_inf, m0, kappa0), OVERHANG, MASS, n=2001)
+    x = np.linspace(0.02 * ref["x"][-1], 0.995 * ref["x"][-1], N_POINTS)
+    z = np.interp(x, ref["x"], ref["z"]) + _bw.NOISE * rng.standard_normal(N_POINTS)
+    return x, z, float(np.degrees(ref["tip_angle"]))
+
+
+def run(quick: bool = False) -> dict:
+    import jax
+
+    jax.config.update("jax_enable_x64", True)  # the cantilever's equilibrium solve
+    from jaxform import cases
+    from jaxform.calibrate import Profile, wrinkle_fit
+    from jaxform.materials import VoceBending
+
+    h = 16e-3 if quick else 8e-3
+    case = cases.resolve("case-a-woven-nlbm", element_size=h, overrides=_bw.OVERRIDES)
+    truth_case = dataclasses.replace(case, fabric=dataclasses.replace(case.fabric, voce=_bw.TRUTH))
+    truth = VoceBending(*_bw.TRUTH)
+    rng = np.random.default_rng(16)
+    sections, _ = _bw.make_sections(truth_case, _bw.FIT_LINES, rng)
+    x, z, tip_deg = _profile(rng)
+    kw = dict(n_starts=2, max_iter=2, gradient_check=False) if quick else {}
+    t0 = time.perf_counter()
+    fit = wrinkle_fit.fit_wrinkles(case, sections, profiles=[Profile(x, z, OVERHANG)], areal_mass=MASS,
+                                   profile_noise=_bw.NOISE, **kw)
+    wall = time.perf_counter() - t0
+    b_err = fit.values["b_init"] / float(truth.b_init) - 1.0
+    high = _bw.moment_error(fit.law, truth, fit.kappa_reach, 0.5 * fit.kappa_reach)
+    return {"element_size_mm": 1e3 * h, "profile": {"overhang_mm": 1e3 * OVERHANG, "areal_mass_gsm": 1e3 * MASS,
+                                                    "tip_angle_deg": tip_deg, "points": N_POINTS},
+            "fit": fit.as_dict(), "fit_wall_s": wall, "b_init_true_Nm": float(truth.b_init),
+            "b_init_err_pct": 100 * b_err, "b_init_sd_pct": 100 * fit.sigma["b_init"] / fit.values["b_init"],
+            "moment_max_rel_err_high_kappa": high,
+            "moment_max_rel_err_all": _bw.moment_error(fit.law, truth, fit.kappa_reach),
+            "kappa_reach_per_m": fit.kappa_reach,
+            "targets": {"b_init_within_3pct": abs(b_err) <= 0.03, "high_kappa_moment_within_15pct": high <= 0.15}}

@@ -27,6 +27,9 @@ STEPS = (0.01, 0.02, 0.05, 0.1, 0.2)
 
 
 def run(quick: bool = False) -> dict:
+    import jax
+
+    jax.config.update("jax_enable_x64", True)  # the case runs in float64
     from jaxform import cases
     from jaxform.calibrate import wrinkle_fit
 

@@ -11,8 +11,9 @@ Residual: per section, the Gaussian-smoothed difference of simulated and measure
 units of the smoothed noise (:mod:`jaxform.calibrate.sections`: tolerant of small wrinkle shifts),
 and with profiles the cantilever fit's z-residuals in units of their noise. The forming rig is
 built once; each trial law is one ``forming.rollout`` of the whole stroke (members of a batch of
-fixed width: 1 on a CPU, run unbatched, because under ``vmap`` every ``lax.cond`` of the contact
-searches runs both branches (measured: 206 s against 4.9 s per 16 mm run); more on an accelerator).
+fixed width: 1 on a CPU, where a batch is no faster per member; more on an accelerator, vmapped over
+:data:`jaxform.batching.BATCH_AXIS` so that the contact searches' ``lax.cond`` stay branches: an
+anonymous vmap runs both branches every step, measured 206 s against 4.9 s per 16 mm run).
 
 Why not plain gradients. Reverse or forward mode through the run is exact (the README: it equals
 central differences at ``h = 1e-8``) but the buckled flange is chaotically sensitive to the law:
@@ -49,6 +50,7 @@ import numpy as np
 from scipy.optimize import least_squares, lsq_linear, minimize
 
 from jaxform import cantilever, forming
+from jaxform.batching import BATCH_AXIS
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
@@ -175,10 +177,7 @@ def _member(q, dz, rig, lines, static):
 @functools.partial(jax.jit, static_argnames=("static",))
 def _batch(Q, Z, rig, lines, static):
     """:func:`_member` over a batch (one compiled program per rig shape, shared by every fit in a process)."""
-    return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static))(Q, Z)
-
-
-_single = jax.jit(_member, static_argnames=("static",))
+    return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static), axis_name=BATCH_AXIS)(Q, Z)
 
 
 @functools.partial(jax.jit, static_argnames=("static",))
@@ -227,11 +226,7 @@ class _Runs:
             pad = chunk + [chunk[-1]] * (self.width - len(chunk))
             Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
             Z = self.dz[np.array([i for _, i in pad])]
-            if self.width == 1:  # unbatched: under vmap every lax.cond of the contact searches runs both branches
-                res = _single(Q[0], Z[0], self.rig, self.lines, self.static)
-                y, v, ok, reach = (np.asarray(t)[None] for t in res)
-            else:
-                y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
+            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
             self.runs += len(chunk)
             for j, (k, _) in enumerate(chunk):
                 out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))

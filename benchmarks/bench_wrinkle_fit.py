@@ -5,7 +5,7 @@ elements. A hidden Voce law unlike the presets and unlike the issue's example (`
 3e-5 N·m, m0 1e-2 N, kappa0 40 1/m, B_init 2.8e-4 N·m; the woven preset is 1.549e-5 / 7.57e-3 / 20,
 B_init 3.94e-4) forms the part; its amplitude d_P along two sections (``FIT_LINES``, a point per
 mm, the points that lie on the part) plus Gaussian noise of 0.05 mm is the data. The fit
-(:func:`jaxform.calibrate.fit_wrinkles`, default settings: gradient check at the start, four
+(:func:`jaxform.calibrate.fit_wrinkles`, default settings: gradient check at the start, eight
 starts, eight optimiser evaluations) starts from the preset law. Reported: the fitted law, the
 largest relative error of M(kappa) against the truth over ``0 < kappa <= kappa_reach`` (the
 curvatures the wrinkles reach, the fit's own figure), the held-out section (``HELD_OUT``, not in
@@ -21,6 +21,7 @@ the two-section fit at 8 mm within 10 min on the 2-core machine.
 from __future__ import annotations
 
 import dataclasses
+import sys
 import time
 
 import numpy as np
@@ -74,6 +75,8 @@ def run(quick: bool = False) -> dict:
 
     def stamp(p):
         stages.setdefault(p.stage, time.perf_counter() - t0)
+        print(f"[{time.perf_counter() - t0:.0f} s] {p.stage}: {p.forming_runs} runs, best loss {p.loss:.4g}",
+              file=sys.stderr, flush=True)
 
     kw = dict(n_starts=2, max_iter=2, gradient_check=False) if quick else {}
     fit = wrinkle_fit.fit_wrinkles(case, sections, callback=stamp, **kw)

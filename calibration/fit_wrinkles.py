@@ -5,7 +5,7 @@ through the forming simulation; jointly with cantilever side profiles when given
         [--section B.csv --line ...] [--profile P.csv --overhang-mm L ... --areal-mass-gsm W]
         [--params voce|voce+shear] --out params.json [--plot fit.png] [--force]
         [--element-size-mm S] [--set KEY=VALUE ...] [--noise-mm 0.05] [--smoothing-mm W] [--ply 1]
-        [--starts 4] [--max-iter 8] [--seeds 1] [--no-gradient-check]
+        [--starts 8] [--max-iter 8] [--seeds 1] [--no-gradient-check]
 
 A section CSV has the header ``s_mm,amplitude_mm``: the position along the line from (X0, Y0) in
 the top view of the formed part (mm, punch axis at the origin, as ``jaxform run`` writes it) and
@@ -112,7 +112,7 @@ def main(argv=None) -> int:
     ap.add_argument("--noise-mm", type=float, default=0.05, help="the sections' measurement noise, mm (default 0.05)")
     ap.add_argument("--smoothing-mm", type=float, help="width of the residual's smoothing, mm (default the element size)")
     ap.add_argument("--ply", type=int, default=1, help="the ply the sections measured (1 touches the punch)")
-    ap.add_argument("--starts", type=int, default=4, help="laws scored in the global phase (default 4)")
+    ap.add_argument("--starts", type=int, default=8, help="laws scored in the global phase (default 8)")
     ap.add_argument("--max-iter", type=int, default=8, help="optimiser evaluations (default 8)")
     ap.add_argument("--seeds", type=int, default=1, help="imperfect blanks averaged per evaluation (default 1)")
     ap.add_argument("--no-gradient-check", action="store_true", help="skip AD vs FD at the start (the fit uses FD)")

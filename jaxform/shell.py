@@ -446,7 +446,8 @@ def _sym_bwd(res, ct):
         parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh, displacement=True), (us,), (r,))
         return sum(ck * parts[k] - dparts[k] for ck, k in zip(c, ("tension", "shear", "bending")))
 
-    (shell_bar,) = jax.vjp(phi, shell)[1](jnp.ones((), us.dtype))
+    val, pull = jax.vjp(phi, shell)
+    (shell_bar,) = pull(jnp.ones_like(val))  # phi's own dtype: float64 where x64 is on and a leaf is a Python float
     return f_r - f_c, shell_bar
 
 

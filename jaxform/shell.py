@@ -434,8 +434,7 @@ def _sym_fwd(us, shell):
 
 
 def _sym_bwd(res, ct):
-    us, shell = res
-    r, c = ct
+    (us, shell), (r, c) = res, ct
     c = (c["tension"], c["shear"], c["bending"])
     # -H r: the forward derivative of the forces along r; sum_k c_k grad E_k: the forces of the
     # c-weighted energy (same kernel and assembly as the forward pass, no transposed gathers)
@@ -446,8 +445,8 @@ def _sym_bwd(res, ct):
         parts, dparts = jax.jvp(lambda z: _parts_soa(z, sh, displacement=True), (us,), (r,))
         return sum(ck * parts[k] - dparts[k] for ck, k in zip(c, ("tension", "shear", "bending")))
 
-    val, pull = jax.vjp(phi, shell)
-    (shell_bar,) = pull(jnp.ones_like(val))  # phi's own dtype: float64 where x64 is on and a leaf is a Python float
+    val, pull = jax.vjp(phi, shell)  # the cotangent in phi's own dtype (float64 under x64 with a float32 rig)
+    (shell_bar,) = pull(jnp.ones_like(val))
     return f_r - f_c, shell_bar
 
 

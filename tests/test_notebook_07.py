@@ -1,8 +1,9 @@
 """Execute notebooks/07_fit_wrinkles.ipynb in quick mode: the wrinkle-section fit end to end
 (synthetic sections from a hidden law at 16 mm, ``fit_wrinkles`` with two starts and three
-evaluations, the held-out prediction, the figure). Part of the default suite (about 100 s alone on
-one core: one compile of the forming program, about 15 runs of 5 s, one compile for the held-out
-section).
+evaluations, the held-out prediction, the figure). Marked ``slow`` (about 100 s alone on one core:
+one compile of the forming program, about 15 runs of 5 s, one compile for the held-out section):
+with it the default suite took 15 min on a fresh clone of the 2-core machine, over its 12 min
+budget; ``pytest -m slow tests/test_notebook_07.py`` runs it.
 
 The quick fit cannot converge in three evaluations; what is checked is that its verdict is honest:
 a fit whose smoothed rows stay more than ``CHI_LIMIT`` noise sds RMS off the data says
@@ -10,11 +11,13 @@ a fit whose smoothed rows stay more than ``CHI_LIMIT`` noise sds RMS off the dat
 """
 import re
 
+import pytest
 from notebook_runner import run_notebook
 
 from jaxform.calibrate.wrinkle_fit import CHI_LIMIT
 
 
+@pytest.mark.slow
 def test_notebook_07_runs(tmp_path, monkeypatch):
     monkeypatch.setenv("JAXFORM_NOTEBOOK_QUICK", "1")
     nb = run_notebook("07_fit_wrinkles.ipynb", tmp_path, timeout=600)

@@ -1,5 +1,4 @@
 """The explicit integrator: energy conservation, stable time step, failure reporting, frames."""
-import warnings
 
 import jax
 import jax.numpy as jnp

@@ -36,8 +36,14 @@ def test_check_section_refuses(kwargs, match):
         S.check_section(_section(**kwargs), CASE)
 
 
-def test_check_section_accepts_a_line_on_the_blank():
-    S.check_section(_section(), CASE)
+def test_check_section_accepts_a_line_to_the_blank_edge_and_refuses_one_a_millimetre_past_it():
+    """The edge of the 250 mm blank is the limit: a section ending on it passes, 1 mm further does not."""
+    edge = _section(s_mm=np.linspace(0.0, 65.0, 14), line_mm=(60.0, 0.0, 125.0, 0.0))
+    assert np.isclose(np.max(np.abs(edge.points())), 0.125)
+    S.check_section(edge, CASE)  # raises if refused
+    past = _section(s_mm=np.linspace(0.0, 66.0, 14), line_mm=(60.0, 0.0, 126.0, 0.0))
+    with pytest.raises(ValueError, match=r"1 of 14 measured points lie outside"):
+        S.check_section(past, CASE)
 
 
 def test_smoothing_tolerates_a_shifted_wrinkle():

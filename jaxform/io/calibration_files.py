@@ -77,6 +77,13 @@ def _refuse_missing(owner, path, cols, names, show=None) -> None:
         )
 
 
+def _sorted_averaged(x, y):
+    """``(x, y)`` sorted by ``x``, the ``y`` of repeated ``x`` averaged."""
+    order = np.argsort(x, kind="stable")
+    ux, inv = np.unique(x[order], return_inverse=True)
+    return ux, np.bincount(inv, weights=y[order]) / np.bincount(inv)
+
+
 def read_profile_csv(path, overhang: float | None = None):
     """Read a cantilever side profile (header ``x_mm,z_mm``) and return ``(x, z)`` in m.
 
@@ -103,12 +110,7 @@ def read_profile_csv(path, overhang: float | None = None):
     x, z = cols["x_mm"], cols["z_mm"]
     if x.size < MIN_POINTS:
         raise ValueError(f"{owner}: {path}: {x.size} points; need at least {MIN_POINTS} along the strip")
-    order = np.argsort(x, kind="stable")
-    x, z = x[order], z[order]
-    ux, inv = np.unique(x, return_inverse=True)
-    if ux.size < x.size:
-        z = np.bincount(inv, weights=z) / np.bincount(inv)
-        x = ux
+    x, z = _sorted_averaged(x, z)
     if x.size < MIN_POINTS:
         raise ValueError(f"{owner}: {path}: {x.size} distinct x values; need at least {MIN_POINTS}")
     if overhang is not None and not (np.isfinite(overhang) and overhang > 0):
@@ -387,12 +389,7 @@ def read_section_csv(path, start, end):
                          "(position along the line from its start, mm; wrinkle amplitude d_P, mm)")
     _refuse_missing(owner, path, cols, ("s_mm", "amplitude_mm"))
     s, a = cols["s_mm"], cols["amplitude_mm"]
-    order = np.argsort(s, kind="stable")
-    s, a = s[order], a[order]
-    us, inv = np.unique(s, return_inverse=True)
-    if us.size < s.size:
-        a = np.bincount(inv, weights=a) / np.bincount(inv)
-        s = us
+    s, a = _sorted_averaged(s, a)
     if s.size < MIN_POINTS:
         raise ValueError(f"{owner}: {path}: {s.size} distinct positions; need at least {MIN_POINTS} along the section")
     return Section(s * 1e-3, a * 1e-3, np.asarray(start, float), np.asarray(end, float), pathlib.Path(path).name)

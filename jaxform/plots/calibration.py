@@ -7,6 +7,16 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 
+def _finish(fig, axes, title: str):
+    """Grid on every axis, the title over the figure, tight layout."""
+    for a in axes:
+        a.grid(alpha=0.3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    return fig
+
+
 def cantilever_fit_figure(fit, profiles, *, title: str = ""):
     """Measured and fitted profiles (mm), and the fitted M–kappa and B–kappa curves.
 
@@ -42,12 +52,7 @@ def cantilever_fit_figure(fit, profiles, *, title: str = ""):
     det_init = "" if getattr(fit, "b_init_determined", True) else " NOT determined"
     axes[2].set_title(f"B_init {fit.b_init:.3g} N·m ± {100 * fit.sigma['b_init'] / fit.b_init:.1f} %{det_init}, "
                       f"B_inf {fit.b_inf:.3g} N·m ({det})", fontsize=9)
-    for a in axes:
-        a.grid(alpha=0.3)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, axes, title)
 
 
 def shear_fit_figure(fit, gamma, force, *, title: str = ""):
@@ -97,12 +102,7 @@ def wrinkle_fit_figure(fit, sections, *, truth=None, title: str = ""):
         ax.set_ylabel(lab)
     axes[n].legend(fontsize=7)
     axes[n + 1].set_title(f"B_init {fit.values['b_init']:.3g} N·m, B_inf {fit.values['b_inf']:.3g} N·m", fontsize=9)
-    for a in axes:
-        a.grid(alpha=0.3)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    return fig
+    return _finish(fig, axes, title)
 
 
 def save(fig, path, dpi: int = 130):

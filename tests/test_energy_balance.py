@@ -10,7 +10,6 @@ ends with several times the float64 kinetic energy at low speed). Evaluating the
 displacement from the reference (edges = reference edges + displacement differences) removes it.
 """
 import jax
-import numpy as np
 import pytest
 
 from jaxform import cases, forming

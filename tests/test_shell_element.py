@@ -4,7 +4,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform.materials import NCF_FCIM359, WOVEN_38616, LinearBending, PolynomialShear, VoceBending
+from jaxform.materials import NCF_FCIM359, WOVEN_38616
 from jaxform.mesh import Mesh
 from jaxform.shell import (Shell, _shear_energy, energy, energy_parts, fibre_curvatures, forces, shear_angle,
                            fibre_vectors, shear_resultant)

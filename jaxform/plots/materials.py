@@ -75,5 +75,3 @@ def shear_figure(fabrics: list[Fabric], *, gamma_max_deg: float = 60.0):
     fig.tight_layout()
     return fig
 
-
-from jaxform.plots.fields import save  # noqa: E402  (one PNG writer for every plot module)

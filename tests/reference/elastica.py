@@ -334,7 +334,7 @@ def _bvp(law: MomentLaw, L: float, w: float, tol: float, s_out):
     sig = np.linspace(0.0, 1.0, 41)
     y = np.vstack([np.zeros_like(sig), 0.5 * (1.0 - sig) ** 2, sig, np.zeros_like(sig)])
     lams = [1.0]
-    res = None
+    res, res_lam = None, 0.0  # the last solved load factor (0: none yet)
     while lams:
         lam = lams[0]
         trial = solve_bvp(make(lam), bc, sig, y, tol=max(tol, 1e-10), bc_tol=1e-13, max_nodes=20000)
@@ -342,7 +342,7 @@ def _bvp(law: MomentLaw, L: float, w: float, tol: float, s_out):
             res, sig, y = trial, trial.x, trial.y
             lams.pop(0)
         else:
-            prev = 0.0 if res is None else res_lam
+            prev = res_lam
             if lam - prev < 1e-3:
                 raise RuntimeError(f"solve_bvp did not converge: {trial.message}")
             lams.insert(0, 0.5 * (prev + lam))

@@ -139,6 +139,36 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(np.isfinite(np.asarray(g))) and float(jnp.abs(g).max()) > 0
 
 
+def test_every_room_of_the_active_lists_gives_the_forces_of_evaluating_all():
+    """The step evaluates the smallest room that holds the active nodes and edges (one slot, an
+    eighth of the lists, the lists, or all on overflow): the same forces in each."""
+    nodes, x0, t = _fold(0.9 * H)
+    x = jnp.asarray(nodes, jnp.float32)
+    v = jnp.zeros_like(x).at[:, 1].set(jnp.where(x[:, 2] > 0.5 * H, 0.01, 0.0))
+    out = {}
+    for frac in (8.0, 1.0, 0.0):  # an eighth of the room holds them all / the whole room / overflow
+        load = _load(x0, t, active_fraction=frac)
+        st = load.initial_state(x)
+        c = st.candidates
+        n_act, e_act = int(jnp.sum(c.active_nodes >= 0)), int(jnp.sum(c.active_edges >= 0))
+        out[frac] = (np.asarray(_force(load, x, v, 0.0, st)[0]), n_act, e_act, load, bool(c.overflow))
+    f_all = out[0.0][0]
+    assert out[0.0][4] and not out[1.0][4] and not out[8.0][4]
+    small = out[8.0][3]
+    assert out[8.0][1] <= small.active_cap // 8 and out[8.0][2] <= small.edge_active_cap // 8  # the small room
+    assert out[1.0][1] > out[1.0][3].active_cap // 8  # the whole lists
+    assert out[8.0][1] > 0 and np.abs(f_all).max() > 0
+    for frac in (8.0, 1.0):
+        np.testing.assert_allclose(out[frac][0], f_all, atol=1e-6 * np.abs(f_all).max())
+    # a flat sheet: nothing active, the one-slot room, no force
+    flat = np.column_stack([x0[:, :2], np.zeros(len(x0))])
+    load = _load(x0, t, active_fraction=1.0)
+    xf = jnp.asarray(flat, jnp.float32)
+    st = load.initial_state(xf)
+    assert int(jnp.sum(st.candidates.active_nodes >= 0)) == 0 and int(jnp.sum(st.candidates.active_edges >= 0)) == 0
+    assert float(jnp.abs(_force(load, xf, jnp.zeros_like(xf), 0.0, st)[0]).max()) == 0.0
+
+
 def test_segment_closest_points_match_a_dense_sampling():
     rng = np.random.default_rng(3)
     p = rng.normal(size=(300, 4, 3))

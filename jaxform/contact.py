@@ -427,6 +427,14 @@ class ToolLoad:
     dt: Any = 0.0
     force_controlled: bool = static_field(default=False)
 
+    def gap(self, x, t, load_state):
+        """(N,) the gap of each node's contacting face to the tool at time ``t``, m (``inf`` for nodes
+        that may not touch it)."""
+        dz = load_state.dz if self.force_controlled else tool_pose(self.tool, t)[0]
+        phi, _ = tools.sdf(self.tool, x, dz)
+        g = phi - jnp.broadcast_to(jnp.asarray(self.offset, x.dtype), phi.shape)
+        return jnp.where(jnp.broadcast_to(jnp.asarray(self.active), phi.shape) > 0, g, jnp.inf)
+
     def force(self, x, v, t, load_state):
         if self.force_controlled:
             dz = load_state.dz

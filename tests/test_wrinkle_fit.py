@@ -4,11 +4,14 @@ runs end to end in notebook 07's test and in ``benchmarks/bench_wrinkle_fit.py``
 import math
 import re
 
+import jax.numpy as jnp
 import numpy as np
 import pytest
 
 from jaxform import cases
 from jaxform.calibrate import sections as S
+from jaxform.calibrate.sections import Section
+from jaxform.contact import ToolLoad
 from jaxform.calibrate import wrinkle_fit as wf
 from jaxform.io import calibration_files as cf
 from jaxform.materials import LinearBending, PolynomialShear, VoceBending, preset
@@ -103,6 +106,31 @@ def test_voce_start_and_imperfections():
     assert np.all(dz[0] == 0) and np.all(dz[:, :, :2] == 0)
     assert np.allclose(np.abs(dz[1:, :, 2]).max(axis=1), 2e-5)
     assert not np.allclose(dz[1], dz[2])
+    # near the tools the field tapers to 0: none where the clearance is under the amplitude, all of it
+    # beyond twice the amplitude, and never more than the clearance less the amplitude between
+    clear = np.linspace(0.0, 6e-5, len(x0))
+    dt = wf.imperfections(x0, 3, 2e-5, 0.2, clearance=clear)
+    assert np.all(dt[:, clear <= 2e-5, 2] == 0)
+    far = clear >= 4e-5
+    np.testing.assert_array_equal(dt[:, far], dz[:, far])
+    assert np.all(np.abs(dt[1:, :, 2]) <= np.maximum(clear - 2e-5, 0.0) + 1e-18)
+
+
+def test_the_fit_s_imperfect_blanks_start_clear_of_the_tools():
+    """An imperfect blank of the fit's rig starts outside holder, die and punch (8 mm woven Case A
+    started 0.1 h deep in holder and die untapered, and blew up)."""
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3)
+    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
+                  end=np.array([0.09, 0.0]))
+    runs = wf._Runs(case, [sec], "voce", 3, 0.1 * case.ply_thickness, 1, 1)
+    model, state = runs.rig[0], runs.rig[1]
+    assert float(jnp.abs(runs.dz[1:]).max()) > 0
+    for k in (1, 2):
+        x = state.x + runs.dz[k]
+        for ld, ls in zip(model.loads, state.loads):
+            if isinstance(ld, ToolLoad):
+                gap0, gap = np.asarray(ld.gap(state.x, state.t, ls)), np.asarray(ld.gap(x, state.t, ls))
+                assert np.all(gap >= np.minimum(gap0, 0.0) - 1e-12)  # nobody pushed into a tool
 
 
 def _cli(argv, capsys):

@@ -10,28 +10,24 @@ Bounds: ``B_init`` and ``kappa0`` within a factor :data:`SPAN` of the starting l
 Residual: per section, the Gaussian-smoothed difference of simulated and measured amplitude in
 units of the smoothed noise (:mod:`jaxform.calibrate.sections`: tolerant of small wrinkle shifts),
 and with profiles the cantilever fit's z-residuals in units of their noise. The forming rig is
-built once; each trial law is one ``forming.rollout`` of the whole stroke (members of a batch of
-fixed width: 1 on a CPU, where a batch is no faster per member; more on an accelerator, vmapped over
-:data:`jaxform.batching.BATCH_AXIS` so that the contact searches' ``lax.cond`` stay branches: an
-anonymous vmap runs both branches every step, measured 206 s against 4.9 s per 16 mm run).
+built once; each trial law is one ``forming.rollout`` of the whole stroke, in batches vmapped over
+:data:`jaxform.batching.BATCH_AXIS` (1 wide on a CPU; an anonymous vmap ran both branches of the
+contact's ``lax.cond`` every step: 206 s against 4.9 s per 16 mm run).
 
-Why not plain gradients. Reverse or forward mode through the run is exact (the README: it equals
-central differences at ``h = 1e-8``) but the buckled flange is chaotically sensitive to the law:
-over a whole stroke the exact derivative is dominated by the choice of bifurcation branch and
-says nothing about the slope of the loss over any finite step (it grows like ``e^{lambda t}``,
-1e4x the ``h = 1e-2`` slope after 1,600 steps). So the fit (1) checks at the start the AD gradient
-of the actual loss against central differences with the fit's step ``fd_step`` (0.05 in log
-space: the scale at which the loss is smooth enough to follow) and records both, (2) uses the AD
-Jacobian only where it agrees with them within :data:`GRAD_RTOL` (the safeguard: otherwise the
-Jacobian by forward differences with ``fd_step``, said in ``gradient_check``), (3) starts from the
-best of the starting law and a seeded Latin hypercube of laws around it (the global phase, box
-:data:`START_HALF_WIDTH`, one run each: along the straight line from the woven preset to a law
-with 0.7x its B_init and 2x its kappa0 the loss falls monotonically, 500x, but the valley bends,
-so a local method from the start stalls) and (4) runs
-``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there. Optional
-``seeds > 1`` averages every evaluation over seeded imperfections of the blank (a smooth random
-out-of-plane field of amplitude ``imperfection``), batched, which smooths the loss further at
-``seeds`` times the cost.
+Why not plain gradients. Reverse mode through the run is exact (it equals central differences at
+``h = 1e-8``), but the buckled flange is chaotically sensitive to the law: over a whole stroke
+the exact derivative grows like ``e^{lambda t}`` and says nothing about the loss over any finite
+step. So the fit (1) checks at the start the AD gradient of the actual loss against central
+differences with its step ``fd_step`` (0.05 in log space) and records both, (2) uses the AD
+Jacobian only where they agree within :data:`GRAD_RTOL` (else forward differences with
+``fd_step``, said in ``gradient_check``), (3) starts from the best of the starting law and a
+seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and (4) runs
+``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there. The loss is
+multimodal: on woven Case A at 8 mm a law with 1.9x the true B_init fits two sections to loss
+1,715 (truth 260) behind a barrier of 54,000 on the straight line between them, at every
+smoothing width from 8 to 40 mm (the buckling branch changes, not a wrinkle's position). Optional
+``seeds > 1`` averages each evaluation over seeded imperfections of the blank (a smooth random
+out-of-plane field of amplitude ``imperfection``, tapered to 0 near the tools), batched.
 
 Uncertainty (Laplace / Gauss-Newton): ``cov(q) = c (J^T J)^-1`` with ``J`` the Jacobian used,
 ``c`` the reduced chi-square (at least 1) times the ratio of section rows to independent section
@@ -54,10 +50,12 @@ from scipy.optimize import least_squares, lsq_linear, minimize
 from scipy.stats.qmc import LatinHypercube
 
 from jaxform import cantilever, forming
+from jaxform.contact import ToolLoad
 from jaxform.batching import BATCH_AXIS
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
+from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
 from jaxform.forming.fields import state_fields
 from jaxform.metrics import section_nrmse
@@ -134,20 +132,6 @@ class Progress(NamedTuple):
     q: tuple
 
 
-def imperfections(x0: np.ndarray, seeds: int, amplitude: float, blank_size: float) -> np.ndarray:
-    """(seeds, N, 3) out-of-plane blank imperfections: seed 0 none, the others a smooth random field
-    (8 Fourier modes of wavelength 1/4 to 1 blank) scaled to ``amplitude`` (m) at its largest."""
-    out = np.zeros((seeds,) + x0.shape)
-    for k in range(1, seeds):
-        rng = np.random.default_rng(k)
-        z = np.zeros(len(x0))
-        for _ in range(8):
-            kx, ky = rng.uniform(-4.0, 4.0, 2) * 2.0 * math.pi / blank_size
-            z += rng.normal() * np.cos(kx * x0[:, 0] + ky * x0[:, 1] + rng.uniform(0, 2 * math.pi))
-        out[k, :, 2] = amplitude * z / max(np.max(np.abs(z)), 1e-30)
-    return out
-
-
 class _Steps(NamedTuple):
     """What :func:`jaxform.forming.rollout` reads of a run's info (hashable: a static argument)."""
 
@@ -213,7 +197,9 @@ class _Runs:
                            for s in sections)
         ns = tuple(sec_mod.n_samples(s, case.element_size) for s in sections)
         self.static = (param_kind, case.n_plies, _Steps(info.n_frames, info.every), ns, False)
-        self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size), self.dtype)
+        clearance = np.min([np.asarray(ld.gap(state.x, state.t, ls), float) for ld, ls in zip(model.loads, state.loads)
+                            if isinstance(ld, ToolLoad)] or [np.full(len(info.x0), np.inf)], axis=0)
+        self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size, clearance), self.dtype)
         self.cache: dict = {}
         self.runs = 0
 

@@ -302,6 +302,10 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
 # ---------------------------------------------------------------------------------------------
 
 
+EXPECTED_PRESSURE = 1.0e5  # Pa, where the penetration is checked (above the paper's 1000 N holder pressure)
+MAX_PENETRATION = 0.1  # the largest penetration under EXPECTED_PRESSURE, a fraction of the ply thickness
+
+
 def auto_penalty_stiffness(areal_mass, dt, *, safety: float = 0.1):
     """Penalty stiffness per unit area, Pa/m, that keeps the contact stable in an explicit step.
 
@@ -322,8 +326,8 @@ def auto_penalty_stiffness(areal_mass, dt, *, safety: float = 0.1):
 
 
 def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_velocity: float = 1.0e-3,
-                   stiffness=None, damping_ratio: float = 0.1, expected_pressure: float = 1.0e5,
-                   max_penetration: float = 0.1, safety: float = 0.1, two_sided: bool = False,
+                   stiffness=None, damping_ratio: float = 0.1, expected_pressure: float = EXPECTED_PRESSURE,
+                   max_penetration: float = MAX_PENETRATION, safety: float = 0.1, two_sided: bool = False,
                    interfaces: int = 1) -> ContactParams:
     """:class:`ContactParams` with the penalty stiffness chosen automatically (or ``stiffness``)
     and the stick limit ``interfaces * dt / areal_mass``, doubled for ``two_sided`` (ply-on-ply)
@@ -503,21 +507,6 @@ class PlyLoad:
         return res.force, st, extras
 
 
-__all__ = [
-    "ContactParams",
-    "ContactResult",
-    "HolderState",
-    "penetration",
-    "regularised_friction",
-    "node_contact",
-    "tool_contact",
-    "tool_pose",
-    "ply_contact",
-    "nearest_faces",
-    "quads_to_triangles",
-    "auto_penalty_stiffness",
-    "contact_params",
-    "holder_step",
-    "ToolLoad",
-    "PlyLoad",
-]
+__all__ = ["EXPECTED_PRESSURE", "MAX_PENETRATION", "ContactParams", "ContactResult", "HolderState", "penetration",
+           "regularised_friction", "node_contact", "tool_contact", "tool_pose", "ply_contact", "nearest_faces",
+           "quads_to_triangles", "auto_penalty_stiffness", "contact_params", "holder_step", "ToolLoad", "PlyLoad"]

@@ -13,6 +13,7 @@ import math
 
 import numpy as np
 
+from jaxform.contact import EXPECTED_PRESSURE, MAX_PENETRATION
 from jaxform.forming.case import Case
 from jaxform.shell import Shell, _ply_frequencies
 
@@ -69,7 +70,7 @@ under the holder, a stack) has two, and the highest mode of a chain of such laye
 ``omega^2 = 4 k / m`` (Gershgorin), so 4 covers any depth of stacking."""
 AUTO_SAFETY = 0.1
 """Automatic contact safety ``(omega_c dt)^2`` where it gives a stiff enough contact."""
-PENETRATION = (1.0e5, 0.1)
+PENETRATION = (EXPECTED_PRESSURE, MAX_PENETRATION)
 """``(pressure Pa, fraction of the ply thickness)``: the automatic contact keeps the penetration
 under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it)."""
 

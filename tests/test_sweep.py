@@ -71,6 +71,10 @@ def test_members_share_a_step_count_and_split_into_groups_and_parts():
     k = [float(r.model.loads[forming.rig.PUNCH].params.stiffness) for r in (r_fast, own)]
     assert k[0] == pytest.approx(k[1], rel=1e-6)
     assert "share" in r_fast.info.numerics.why
+    # the step budget (omega dt / 2 of shell and contacts) of the shorter step: in proportion to it
+    ratio = r_fast.info.dt / own.info.dt
+    assert r_fast.info.numerics.budget == pytest.approx(own.info.numerics.budget * ratio, rel=1e-9) and ratio < 1
+    assert r_fast.info.numerics.safety == pytest.approx(own.info.numerics.safety * ratio**2, rel=1e-9)
     with pytest.raises(ValueError, match="at least"):
         forming.build(fast, every=own.info.every - own.info.samples_per_frame)
     # memory: a group that would not fit is split, and says so

@@ -76,14 +76,15 @@ def run(args) -> int:
     from jaxform.io.output import prepare_output_dir
     from jaxform.materials import NCF_FCIM359, TABLE1_LBM, WOVEN_38616
     from jaxform.plots import materials as mplots
+    from jaxform.plots.fields import save
 
     print("jaxform demo: the source paper's two fabrics (Table 1, SI units)\n")
     print(material_table())
     out = prepare_output_dir(args.out, force=args.force, owner="demo")
     written = [
-        mplots.save(mplots.bending_figure(WOVEN_38616, TABLE1_LBM[WOVEN_38616.name]), out / "fig1_woven_bending.png"),
-        mplots.save(mplots.bending_figure(NCF_FCIM359, TABLE1_LBM[NCF_FCIM359.name]), out / "fig2_ncf_bending.png"),
-        mplots.save(mplots.shear_figure([WOVEN_38616, NCF_FCIM359]), out / "shear_laws.png"),
+        save(mplots.bending_figure(WOVEN_38616, TABLE1_LBM[WOVEN_38616.name]), out / "fig1_woven_bending.png"),
+        save(mplots.bending_figure(NCF_FCIM359, TABLE1_LBM[NCF_FCIM359.name]), out / "fig2_ncf_bending.png"),
+        save(mplots.shear_figure([WOVEN_38616, NCF_FCIM359]), out / "shear_laws.png"),
     ]
     print(f"\nWrote {len(written)} plots to {out.resolve()}:")
     for path in written:

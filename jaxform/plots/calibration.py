@@ -6,6 +6,8 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 
+from jaxform.plots.fields import save
+
 
 def _finish(fig, axes, title: str):
     """Grid on every axis, the title over the figure, tight layout."""
@@ -104,12 +106,6 @@ def wrinkle_fit_figure(fit, sections, *, truth=None, title: str = ""):
     axes[n + 1].set_title(f"B_init {fit.values['b_init']:.3g} N·m, B_inf {fit.values['b_inf']:.3g} N·m", fontsize=9)
     return _finish(fig, axes, title)
 
-
-def save(fig, path, dpi: int = 130):
-    """Write a figure as PNG and close it."""
-    fig.savefig(path, dpi=dpi)
-    plt.close(fig)
-    return path
 
 
 __all__ = ["cantilever_fit_figure", "shear_fit_figure", "wrinkle_fit_figure", "save"]

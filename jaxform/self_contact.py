@@ -106,15 +106,6 @@ def near_edges(x0, edges, group, exclusion, *, chunk: int = 1 << 18) -> np.ndarr
 _segments_sqdist_host = jax.jit(segments_sqdist)
 
 
-SMALL_ROOM = 8
-"""The small room of the active lists is ``1 / SMALL_ROOM`` of theirs (at least 8 slots): a run with
-few nodes near a fold evaluates that many per step instead of the whole room."""
-
-
-def _small_room(size: int) -> int:
-    return max(8, size // SMALL_ROOM)
-
-
 def _compact(mask, size: int):
     """``(ids (size,) int32, -1 padded; overflow () bool)``: the indices where ``mask`` holds."""
     ids = jnp.nonzero(mask, size=size, fill_value=-1)[0].astype(jnp.int32)
@@ -315,21 +306,16 @@ class SelfContactLoad:
                 "max_pressure": jnp.maximum(jnp.max(res.pressure * wn), jnp.max(ee.pressure * we)),
                 "min_gap": jnp.min(jnp.where(wn, res.gap, inf)), "min_edge_gap": jnp.min(jnp.where(we, ee.gap, inf))}
 
-        # the smallest of four rooms that holds the active nodes and edges: one slot (none active: a
-        # flat or smoothly bent ply), the first 1/SMALL_ROOM of the active lists (they are padded at
-        # the end), the whole lists, or everything when they overflow; in a batch of runs every
-        # member takes the larger room when one needs it (jaxform.batching)
-        def room(sn, se):
-            return lambda: part(c.active_nodes[:sn], c.active_edges[:se])
-
-        def fits(sn, se):
-            return ~any_member(~((c.active_nodes[sn] < 0) & (c.active_edges[se] < 0)))
-
-        sn, se = _small_room(self.active_cap), _small_room(self.edge_active_cap)
+        # the smallest of three rooms that holds the active nodes and edges: one slot (none active: a
+        # flat or smoothly bent ply), the active lists, or everything when they overflow (each room is
+        # one more compiled copy of the contact: a fourth, an eighth of the lists, cost 16 % more
+        # compile time for little); in a batch of runs every member takes the larger room when one
+        # needs it (jaxform.batching)
+        none = ~any_member(~((c.active_nodes[1] < 0) & (c.active_edges[1] < 0)))
         f, extras = jax.lax.cond(
             any_member(c.overflow), lambda: part(self.slave, jnp.arange(self.edges.shape[0])),
-            lambda: jax.lax.cond(fits(sn, se), lambda: jax.lax.cond(fits(1, 1), room(1, 1), room(sn, se)),
-                                 room(self.active_cap, self.edge_active_cap)))
+            lambda: jax.lax.cond(none, lambda: part(c.active_nodes[:1], c.active_edges[:1]),
+                                 lambda: part(c.active_nodes, c.active_edges)))
         extras.update(refreshes=st.refreshes, active_overflow=c.overflow.astype(jnp.int32))
         return f, st, extras
 

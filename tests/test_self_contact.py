@@ -140,13 +140,13 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
 
 
 def test_every_room_of_the_active_lists_gives_the_forces_of_evaluating_all():
-    """The step evaluates the smallest room that holds the active nodes and edges (one slot, an
-    eighth of the lists, the lists, or all on overflow): the same forces in each."""
+    """The step evaluates the smallest room that holds the active nodes and edges (one slot, the
+    lists, or all on overflow): the same forces in each."""
     nodes, x0, t = _fold(0.9 * H)
     x = jnp.asarray(nodes, jnp.float32)
     v = jnp.zeros_like(x).at[:, 1].set(jnp.where(x[:, 2] > 0.5 * H, 0.01, 0.0))
     out = {}
-    for frac in (8.0, 1.0, 0.0):  # an eighth of the room holds them all / the whole room / overflow
+    for frac in (8.0, 1.0, 0.0):  # a room 8x the lists / the lists / overflow
         load = _load(x0, t, active_fraction=frac)
         st = load.initial_state(x)
         c = st.candidates
@@ -154,9 +154,6 @@ def test_every_room_of_the_active_lists_gives_the_forces_of_evaluating_all():
         out[frac] = (np.asarray(_force(load, x, v, 0.0, st)[0]), n_act, e_act, load, bool(c.overflow))
     f_all = out[0.0][0]
     assert out[0.0][4] and not out[1.0][4] and not out[8.0][4]
-    small = out[8.0][3]
-    assert out[8.0][1] <= small.active_cap // 8 and out[8.0][2] <= small.edge_active_cap // 8  # the small room
-    assert out[1.0][1] > out[1.0][3].active_cap // 8  # the whole lists
     assert out[8.0][1] > 0 and np.abs(f_all).max() > 0
     for frac in (8.0, 1.0):
         np.testing.assert_allclose(out[frac][0], f_all, atol=1e-6 * np.abs(f_all).max())

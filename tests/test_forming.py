@@ -52,7 +52,8 @@ def test_orientations_rotate_the_fibres():
     assert model.shell.fabrics[0].fibre_angles == pytest.approx((math.radians(30), math.radians(120)))
 
 
-@pytest.mark.parametrize("fabric", ["woven", "ncf"])
+# NCF Case B (23 s, another compiled two-ply program) runs with -m slow; woven in the default run
+@pytest.mark.parametrize("fabric", ["woven", pytest.param("ncf", marks=pytest.mark.slow)])
 def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N(fabric):
     case = _coarse(f"case-b-{fabric}-nlbm", size_mm=25.0, process__stroke_mm=5, process__frames=2)
     r = forming.simulate(case, samples_per_frame=12)
@@ -76,8 +77,9 @@ def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N(fabric):
 
 
 def test_gradients_of_a_short_run_match_finite_differences():
-    """d(outputs)/d(b_inf, first shear coefficient) of a 3 mm stroke, float64, against central
-    differences: the mean sag (mm) of the blank inside r = 70 mm and the mean squared displacement.
+    """d(output)/d(b_inf, first shear coefficient) of a 3 mm stroke by reverse mode, float64,
+    against central differences: the output is the mean sag (mm) of the blank inside r = 70 mm plus
+    the mean squared displacement, each divided by its value at the start.
     Self-contact off: a 3 mm stroke of a flat blank has none (every pair is inside the exclusion),
     and its program doubled this test's compile; its gradients are tested in test_self_contact.
     Contact safety 0.1 as given: the automatic choice takes a 2.1x larger step on this 25 mm mesh,
@@ -102,15 +104,21 @@ def test_gradients_of_a_short_run_match_finite_differences():
         return jnp.stack([jnp.sum(inner * u[:, 2]) / jnp.sum(inner), jnp.mean(jnp.sum(u * u, axis=1))])
 
     b, c = float(law.b_inf), float(c0[0])
-    f = jax.jit(out)
-    y = np.asarray(f(b, c))
+    f_out = jax.jit(out)
+    y = np.asarray(f_out(b, c))
     assert y[0] < -0.05  # the blank did move
-    jac = jax.jit(jax.jacrev(out, argnums=(0, 1)))(b, c)
+    # one reverse pass of both outputs, each weighted by its size so that neither drowns (the
+    # Jacobian's two cotangents compiled the reverse program for 28 s instead of 20)
+    w = 1.0 / np.abs(y)
+
+    def f(b_inf, c1):
+        return float(w @ np.asarray(f_out(b_inf, c1)))
+
+    grad = jax.jit(jax.grad(lambda b_inf, c1: jnp.dot(w, out(b_inf, c1)), argnums=(0, 1)))(b, c)
     for i, dx in enumerate((1e-3 * b, 1e-3 * c)):
         fd = central_difference(lambda p: f(*p), [b, c], dx, index=i)
-        g = np.asarray(jac[i])
-        assert np.all(np.abs(fd) > 0)
-        np.testing.assert_allclose(g, fd, rtol=1e-3)
+        assert np.abs(fd) > 0
+        np.testing.assert_allclose(float(grad[i]), fd, rtol=1e-3)
 
 
 QUASI_STATIC = ("process.speed_mm_per_s=62.5", "numerics.fibre_mass_scaling=3", "contact.safety=0.5")

@@ -127,6 +127,8 @@ def _free_port():
         return s.getsockname()[1]
 
 
+# 51 s in the default run (two processes compiling the same program at once): run with -m slow
+@pytest.mark.slow
 def test_two_processes_share_a_sweep_and_process_0_gathers_the_table(swept, tmp_path):
     _, _, rows = swept
     out = tmp_path / "two"

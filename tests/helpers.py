@@ -2,6 +2,11 @@
 small stand-in cantilever models that the calibration scripts load with ``--simulate helpers:NAME``."""
 import numpy as np
 
+FAST = "process.speed_mm_per_s=500"
+"""The presets' former punch speed: for tests of wiring, contact, gradients and output, where the
+automatic quasi-static speed (4-8x slower, :func:`jaxform.forming.numerics.quasi_static_speed`)
+would only cost time."""
+
 
 def central_difference(f, x, h, *, index=None, direction=None):
     """Central difference ``(f(x + h d) - f(x - h d)) / (2 h)`` as a float64 numpy array.

@@ -44,7 +44,8 @@ def test_build_tools_places_the_rig():
     assert float(rig.holder.bottom_z) == pytest.approx(2 * h)
     assert cases.ply_heights(case) == pytest.approx([1.5 * h, 0.5 * h])
     assert float(rig.punch.motion.displacement(1e3)) == pytest.approx(-0.05)
-    assert forming.stroke_time(case) == pytest.approx(0.05 / 0.5 + 0.5 * 0.1 * 0.1)
+    v = case.process.speed  # the automatic quasi-static speed; the ramp takes 10 % of the stroke at half speed
+    assert forming.stroke_time(case) == pytest.approx(0.05 / v + 0.5 * 0.1 * 0.05 / v)
     a = forming.build_tools(cases.load("case-a-woven-nlbm"))
     assert float(a.holder.bottom_z) == pytest.approx(7e-3)
 
@@ -160,3 +161,24 @@ def test_contact_damping_bound_follows_the_explicit_stability_limit():
     cases.apply_overrides(case, ["contact.damping_ratio=0.88"])
     with pytest.raises(ValueError, match="contact.safety = auto the explicit step is stable only up to 0.886"):
         cases.apply_overrides(case, ["contact.damping_ratio=1.0"])
+
+
+def test_automatic_punch_speed_follows_the_fibre_layout_and_round_trips():
+    """``process.speed_mm_per_s = "auto"`` (the presets): the quasi-static speed of the study for
+    the plies' fibre layout, recorded as chosen; a given speed is kept and dumps as given."""
+    from jaxform.forming.speed import QUASI_STATIC_SPEED
+
+    woven, ncf = cases.load("case-a-woven-nlbm"), cases.load("case-a-ncf-nlbm")
+    assert woven.process.speed == QUASI_STATIC_SPEED["along"] and "auto" in woven.process.speed_choice
+    assert ncf.process.speed == QUASI_STATIC_SPEED["off_axis"]
+    assert QUASI_STATIC_SPEED["off_axis"] < 0.5 and QUASI_STATIC_SPEED["along"] < 0.5  # slower than the former 500 mm/s
+    turned = cases.apply_overrides(woven, ["plies.orientations_deg=[45.0]"])  # woven at 45 deg: fibres off the edges
+    assert turned.process.speed == QUASI_STATIC_SPEED["off_axis"]
+    assert cases.to_dict(woven)["process"]["speed_mm_per_s"] == "auto"
+    given = cases.apply_overrides(woven, ["process.speed_mm_per_s=250"])
+    assert given.process.speed == pytest.approx(0.25) and given.process.speed_choice is None
+    assert cases.to_dict(given)["process"]["speed_mm_per_s"] == pytest.approx(250.0)
+    with pytest.raises(ValueError, match="speed_mm_per_s"):
+        cases.apply_overrides(woven, ["process.speed_mm_per_s=-1"])
+    with pytest.raises(ValueError, match="speed_mm_per_s"):
+        cases.apply_overrides(woven, ['process.speed_mm_per_s="fast"'])

@@ -8,7 +8,9 @@ import pytest
 
 from jaxform.cli import main
 
-FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]
+# the presets' former 500 mm/s, not the automatic quasi-static speed: these tests check the outputs
+FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--set",
+        "process.speed_mm_per_s=500", "--quiet"]
 FIELDS = ("displacement_m", "shear_angle_deg", "fibre_strain", "bending_moment_N", "M_f_rms_N", "contact_pressure_Pa",
           "deviation_m", "ply_id")
 
@@ -28,6 +30,7 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     n = s["numerics"]
     assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
     assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
+    assert n["speed_choice"] == "given" and "punch 500 mm/s (given)" in text
     for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s"):
         assert isinstance(s[key], float) and np.isfinite(s[key])
     assert s["inputs"]["blank"]["element_size_mm"] == 25.0 and s["inputs"]["process"]["stroke_mm"] == 4.0

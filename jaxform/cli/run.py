@@ -202,7 +202,8 @@ def report(result, written, out, stream=None):
         mass = "off" if fm == 1.0 else f"x{fm:g}" + (" (auto)" if n.get("fibre_mass_choice") == "auto" else "") + (
             " with its momentum term" if n.get("fibre_mass_momentum_term") else "")
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
-              f"{safety}, fibre mass {mass}", file=stream)
+              f"{safety}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
+              f"({n.get('speed_choice', 'given')})", file=stream)
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)

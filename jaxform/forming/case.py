@@ -20,7 +20,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                holder_opening_radius_mm, holder_edge_radius_mm, holder_thickness_mm,
                optional punch_mesh = "file.stl", punch_mesh_units, punch_mesh_cell_mm
     [holder]   mode = "gap" | "force"; gap_mm (gap mode); force_N, mass_kg (force mode)
-    [process]  stroke_mm, speed_mm_per_s (simulated punch speed), ramp_fraction, frames
+    [process]  stroke_mm, speed_mm_per_s (simulated punch speed, or "auto": the quasi-static speed of
+               jaxform.forming.numerics.quasi_static_speed), ramp_fraction, frames
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety ("auto" or a number in
                (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
                damping_ratio, optional self_contact (default true: folds lie on themselves)
@@ -39,6 +40,7 @@ import math
 from typing import Any
 
 from jaxform import units
+from jaxform.forming.speed import quasi_static_speed
 
 BENDING_MODELS = ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")
 LBM_VARIANTS = {"lbm-init": "init", "lbm-41": "41.5", "lbm-inf": "inf"}
@@ -100,6 +102,7 @@ class ProcessSpec:
     speed: float
     ramp_fraction: float
     frames: int
+    speed_choice: str | None = None  # why, when the speed was chosen ("auto": jaxform.forming.numerics.quasi_static_speed)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -177,7 +180,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
     },
     "holder": {"mode": ("str", True), "gap_mm": ("float", False), "force_N": ("float", False),
                "mass_kg": ("float", False)},
-    "process": {"stroke_mm": ("float", True), "speed_mm_per_s": ("float", True),
+    "process": {"stroke_mm": ("float", True), "speed_mm_per_s": ("auto", True),
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
@@ -337,14 +340,16 @@ def _build(d) -> Case:
                         force=h.get("force_N"), mass=h.get("mass_kg"))
 
     p = d["process"]
-    for key in ("stroke_mm", "speed_mm_per_s"):
+    for key in ("stroke_mm",) + (() if p["speed_mm_per_s"] == "auto" else ("speed_mm_per_s",)):
         _positive(d, key, "process")
     if not 0 <= p["ramp_fraction"] < 1:
         raise _err("process.ramp_fraction", p["ramp_fraction"], "must lie in [0, 1)")
     if p["frames"] < 2:
         raise _err("process.frames", p["frames"], "must be >= 2")
-    process = ProcessSpec(stroke=p["stroke_mm"] * _MM, speed=p["speed_mm_per_s"] * _MM,
-                          ramp_fraction=p["ramp_fraction"], frames=p["frames"])
+    speed, choice = (quasi_static_speed(fabric.preset, [math.radians(a) for a in d["plies"]["orientations_deg"]])
+                     if p["speed_mm_per_s"] == "auto" else (p["speed_mm_per_s"] * _MM, None))
+    process = ProcessSpec(stroke=p["stroke_mm"] * _MM, speed=speed, ramp_fraction=p["ramp_fraction"],
+                          frames=p["frames"], speed_choice=choice)
 
     c = d["contact"]
     k = c["penalty_stiffness_Pa_per_m"]
@@ -498,7 +503,8 @@ def to_dict(case: Case) -> dict:
         "blank": {"size_mm": _mm(case.blank_size), "element_size_mm": _mm(case.element_size)},
         "tools": tools_d,
         "holder": holder,
-        "process": {"stroke_mm": _mm(p.stroke), "speed_mm_per_s": _mm(p.speed), "ramp_fraction": p.ramp_fraction,
+        "process": {"stroke_mm": _mm(p.stroke), "speed_mm_per_s": "auto" if p.speed_choice else _mm(p.speed),
+                    "ramp_fraction": p.ramp_fraction,
                     "frames": p.frames},
         "contact": {"penalty_stiffness_Pa_per_m": "auto" if c.penalty_stiffness is None else c.penalty_stiffness,
                     "safety": "auto" if c.safety is None else c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,

@@ -15,6 +15,7 @@ import numpy as np
 
 from jaxform.contact import EXPECTED_PRESSURE, MAX_PENETRATION
 from jaxform.forming.case import Case
+from jaxform.forming.speed import along_edges
 from jaxform.shell import Shell, _ply_frequencies
 
 FIBRE_MASS_MAX = 12.0
@@ -35,12 +36,6 @@ FIBRE_MASS_RESERVE = 1.25
 """The automatic fibre-mass factor brings the step to within this factor of the bending limit."""
 
 
-def _along_edges(fabric, tol_deg: float = 10.0) -> bool:
-    """Both fibre families of ``fabric`` within ``tol_deg`` of the blank's x or y axis."""
-    return all(min(a % (0.5 * math.pi), 0.5 * math.pi - a % (0.5 * math.pi)) <= math.radians(tol_deg)
-               for a in (float(t) for t in fabric.fibre_angles))
-
-
 def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False) -> float:
     """``numerics.fibre_mass_scaling = "auto"``: the smallest factor ``s`` that brings the shell's
     stable step to within :data:`FIBRE_MASS_RESERVE` of its bending limit (``sqrt(omega_b^2 +
@@ -55,7 +50,7 @@ def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False) -
     need, cap = 1.0, FIBRE_MASS_MAX
     for (wm, wb), fab in zip(_ply_frequencies(shell, mass_scale), shell.fabrics):
         need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
-        if not _along_edges(fab) and not momentum_term:
+        if not along_edges(fab.fibre_angles) and not momentum_term:
             cap = min(cap, FIBRE_MASS_MAX_OFF_AXIS)
     return float(min(cap, math.ceil(need)))
 

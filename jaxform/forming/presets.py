@@ -18,7 +18,7 @@ _BASE = {
     "tools": {"punch_radius_mm": 50.0, "die_opening_radius_mm": 53.0, "die_fillet_mm": 6.0,
               "die_thickness_mm": 20.0, "holder_opening_radius_mm": 53.0, "holder_edge_radius_mm": 1.0,
               "holder_thickness_mm": 20.0},
-    "process": {"stroke_mm": 50.0, "speed_mm_per_s": 500.0, "ramp_fraction": 0.1, "frames": 11},
+    "process": {"stroke_mm": 50.0, "speed_mm_per_s": "auto", "ramp_fraction": 0.1, "frames": 11},
     "contact": {"penalty_stiffness_Pa_per_m": "auto", "safety": "auto", "slip_velocity_fraction": 0.01,
                 "damping_ratio": 0.1},
     "numerics": {"dtype": "float32", "mass_scaling": 1.0},

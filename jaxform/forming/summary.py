@@ -114,7 +114,8 @@ def summarize(result) -> dict:
                      # products with the fibre-tension stiffness per step: degree - 1
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,
-                     "punch_speed_m_per_s": float(case.process.speed), **_step_choice(info)},
+                     "punch_speed_m_per_s": float(case.process.speed),
+                     "speed_choice": getattr(case.process, "speed_choice", None) or "given", **_step_choice(info)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,

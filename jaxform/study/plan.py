@@ -17,8 +17,8 @@ from jaxform.forming.case import BENDING_MODELS
 SETS = {"case-a-woven": ("woven", "a"), "case-a-ncf": ("ncf", "a"), "case-b": (None, "b")}
 """The study's parts (``--only``): name -> (fabric or None for both, paper case)."""
 SETTINGS = ("numerics.fibre_mass_scaling=auto",)
-"""Overrides every study run gets before the user's ``--set`` (the presets' punch speed is kept:
-see the report's numerics section for what that means)."""
+"""Overrides every study run gets before the user's ``--set`` (the presets' automatic quasi-static
+punch speed is kept, :mod:`jaxform.forming.speed`; the report's numerics section says what ran)."""
 FABRIC_SETTINGS = {"ncf": ("numerics.fibre_mass_momentum_term=true",)}
 """Overrides by fabric, after :data:`SETTINGS`. The +-45 deg NCF's fibres run off the blank's
 edges, where its corners are held in-plane by shear alone: with the fibre mass but without its

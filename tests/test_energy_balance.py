@@ -47,6 +47,9 @@ def test_balance_float32_no_rounding_drift():
     assert abs(res) < 1e-2 * stored  # measured 7.5e-2 on absolute positions, 8.8e-4 on displacements
 
 
+# 28 s of the default run (two float64 programs): -m slow; test_fibre_mass keeps the
+# free-vibration and spinning-sheet energy checks of the fibre mass in the default run
+@pytest.mark.slow
 def test_fibre_mass_keeps_the_energies_and_closes_the_balance_in_float64():
     """With fibre-selective mass 4 the kinetic energy ``1/2 v_mid . p_mid`` closes the balance at
     the 4x larger step (time-step error: measured 2.6e-3 of the stored energy, 1.7e-4 at half

@@ -96,6 +96,8 @@ def test_distance_closest_point_need_not_be_a_vertex():
     np.testing.assert_allclose(d, [0.3, 0.0, np.sqrt(2.0), np.sqrt(0.25 + 1.0)], atol=1e-14)
 
 
+# 13 s of the default run (the search compiled again in float32): -m slow
+@pytest.mark.slow
 def test_distance_float32_and_int32(small_tool):
     v, f = small_tool
     x = _query_points(np.random.default_rng(2), 200)

@@ -1,15 +1,14 @@
 """Punch-speed convergence study (issue 13): the data a quasi-static speed rule is read from.
 
 For each (preset, element size) the same case runs at a ladder of punch speeds, each half the one
-before, with the presets' numerics as shipped except the speed (and, where named, the automatic
-fibre mass). Consecutive rungs are compared by :func:`jaxform.forming.quasi_static_check`: the
+before, with the presets' numerics as shipped except the speed and the fibre mass (automatic). Consecutive rungs are compared by :func:`jaxform.forming.quasi_static_check`: the
 final shear map's 95th percentile difference (limit 1 deg), the edge mid-side draw-in (2 %) and
 the flange wrinkle count (no change). The first rung that passes against its half is the
 converged speed of that case and size.
 
 ``run(quick)`` returns, per case and size, each rung's figures (wall time, steps, step, KE/IE,
-max shear, draw-in, wrinkles) and each comparison. Writes after each case through the driver; run
-one ladder at a time with ``JAXFORM_SPEED_CASES="case-a-woven-nlbm:8"`` (comma-separated
+max shear, draw-in, wrinkles) and each comparison; each rung is also printed as it ends (the driver
+writes the file when the whole benchmark ends). Run one ladder at a time with ``JAXFORM_SPEED_CASES="case-a-woven-nlbm:8"`` (comma-separated
 ``name:size_mm``) and ``JAXFORM_SPEED_LADDER="500,250,125,62.5"`` (mm/s).
 """
 from __future__ import annotations

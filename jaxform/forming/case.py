@@ -102,7 +102,7 @@ class ProcessSpec:
     speed: float
     ramp_fraction: float
     frames: int
-    speed_choice: str | None = None  # why, when the speed was chosen ("auto": jaxform.forming.numerics.quasi_static_speed)
+    speed_choice: str | None = None  # why, when the speed was chosen ("auto": jaxform.forming.speed.quasi_static_speed)
 
 
 @dataclasses.dataclass(frozen=True)

@@ -115,7 +115,7 @@ def summarize(result) -> dict:
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,
                      "punch_speed_m_per_s": float(case.process.speed),
-                     "speed_choice": getattr(case.process, "speed_choice", None) or "given", **_step_choice(info)},
+                     "speed_choice": case.process.speed_choice or "given", **_step_choice(info)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,

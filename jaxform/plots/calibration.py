@@ -107,5 +107,4 @@ def wrinkle_fit_figure(fit, sections, *, truth=None, title: str = ""):
     return _finish(fig, axes, title)
 
 
-
 __all__ = ["cantilever_fit_figure", "shear_fit_figure", "wrinkle_fit_figure", "save"]

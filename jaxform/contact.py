@@ -44,6 +44,7 @@ the same central-difference (leapfrog) scheme as the fabric.
 """
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import jax
@@ -325,6 +326,14 @@ def auto_penalty_stiffness(areal_mass, dt, *, safety: float = 0.1):
     return safety * areal_mass / dt**2
 
 
+def stable_damping_ratio(safety: float) -> float:
+    """Largest contact damping ratio a stable explicit step allows with the automatic stiffness
+    ``k = safety rho_A / dt^2`` (``omega dt = sqrt(safety)``): central differences with velocity
+    damping stay stable while ``omega dt <= 2 (sqrt(1 + zeta^2) - zeta)``, i.e. ``zeta <= (4 -
+    safety) / (4 sqrt(safety))``."""
+    return (4.0 - safety) / (4.0 * math.sqrt(safety))
+
+
 def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_velocity: float = 1.0e-3,
                    stiffness=None, damping_ratio: float = 0.1, expected_pressure: float = EXPECTED_PRESSURE,
                    max_penetration: float = MAX_PENETRATION, safety: float = 0.1, two_sided: bool = False,
@@ -509,4 +518,4 @@ class PlyLoad:
 
 __all__ = ["EXPECTED_PRESSURE", "MAX_PENETRATION", "ContactParams", "ContactResult", "HolderState", "penetration",
            "regularised_friction", "node_contact", "tool_contact", "tool_pose", "ply_contact", "nearest_faces",
-           "quads_to_triangles", "auto_penalty_stiffness", "contact_params", "holder_step", "ToolLoad", "PlyLoad"]
+           "quads_to_triangles", "auto_penalty_stiffness", "stable_damping_ratio", "contact_params", "holder_step", "ToolLoad", "PlyLoad"]

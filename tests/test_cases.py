@@ -82,6 +82,8 @@ def test_each_validation_error_names_its_key():
     assert "'numerics.dtype'" in _error_of(lambda d: d["numerics"].update(dtype="float16"))
     assert "'contact.penalty_stiffness_Pa_per_m'" in _error_of(lambda d: d["contact"].update(penalty_stiffness_Pa_per_m=-1.0))
     assert "'plies.orientations_deg'" in _error_of(lambda d: d["plies"].update(orientations_deg=[]))
+    for bad in (0.0, -1e4, float("inf"), float("nan")):
+        assert "'contact.expected_pressure_Pa'" in _error_of(lambda d: d["contact"].update(expected_pressure_Pa=bad))
     # Eight plies of 0.3 mm do not fit a 2 mm gap.
     def thick(d):
         d["plies"]["orientations_deg"] = [0.0] * 8
@@ -113,9 +115,12 @@ def test_overrides():
 def test_toml_file_roundtrip_and_unknown_names(tmp_path):
     from jaxform.io.case_file import read_case, write_case
 
-    case = cases.apply_overrides(cases.load("case-b-ncf-nlbm"), ["process.frames=21", "fabric.thickness_mm=0.45"])
+    case = cases.apply_overrides(cases.load("case-b-ncf-nlbm"), ["process.frames=21", "fabric.thickness_mm=0.45",
+                                                               "contact.expected_pressure_Pa=3e4"])
     path = write_case(case, tmp_path / "my.toml")
-    assert cases.load(str(path)) == case
+    assert cases.load(str(path)) == case and case.contact.expected_pressure == 3e4
+    assert cases.load("case-b-ncf-nlbm").contact.expected_pressure is None  # 'auto'
+    assert 'expected_pressure_Pa = "auto"' in cases.to_toml(cases.load("case-b-ncf-nlbm"))
     assert read_case(path).ply_thickness == pytest.approx(0.45e-3)
     with pytest.raises(FileExistsError):
         write_case(case, path)

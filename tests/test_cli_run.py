@@ -31,6 +31,10 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
     assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
     assert n["speed_choice"] == "given" and "punch 500 mm/s (given)" in text
+    # the contact's expected pressure (no clamping: 1e4 Pa) and the deepest penetration seen, within it
+    assert n["expected_pressure_Pa"] == 1e4 and n["expected_pressure_choice"].startswith("auto")
+    assert 0 < n["max_penetration_ply"] < n["penetration_limit_ply"] == 0.1 and "penetrated" not in text
+    assert len(s["history"]["max_penetration_m"]) == len(s["history"]["t_s"])
     for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s"):
         assert isinstance(s[key], float) and np.isfinite(s[key])
     assert s["inputs"]["blank"]["element_size_mm"] == 25.0 and s["inputs"]["process"]["stroke_mm"] == 4.0
@@ -213,6 +217,18 @@ def test_a_run_that_leaves_its_physical_bounds_stops_and_says_why(tmp_out):
     assert not result.complete and "physical bounds" in result.reason and "m/s" in result.reason
     assert result.summary["complete"] is False and len(result.t) == 1
     assert len(_pvd_files(tmp_out)) == 1
+
+
+def test_a_contact_too_soft_for_the_pressures_stops_the_run_and_says_which_key(tmp_out, capsys):
+    """A contact set for 1 Pa (the penalty 1e5 Pa/m: 10 um at 1 Pa) under the punch's tens of Pa: the
+    fabric sinks into the punch by more than half the ply, and the run stops saying so."""
+    args = ["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--set", "contact.expected_pressure_Pa=1",
+            "--set", "contact.penalty_stiffness_Pa_per_m=1e5"]
+    assert main(args) == 1
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False and "physical bounds" in s["reason"]
+    assert "penetrated a tool or ply" in s["reason"] and "contact.expected_pressure_Pa" in s["reason"]
+    assert s["inputs"]["contact"]["expected_pressure_Pa"] == 1.0
 
 
 def test_a_run_blown_up_by_an_impossible_contact_damping_is_refused_at_the_edge(tmp_out, capsys):

@@ -161,15 +161,18 @@ def _numerics(name, size_mm, *keys):
 
 def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_stable():
     """contact.safety = 'auto': where the shell's step allows a stiff enough contact it is kept
-    (4 mm, no fibre mass: safety 0.1 as before); with fibre mass 12 at 2 mm the contact sets the
-    step, at the budget (omega dt / 2 = 0.9 with four contacts on a node) and with the stiffness
-    that keeps 1e5 Pa below 10% of the ply; the former advice (safety 0.5) broke that budget."""
+    (4 mm, no fibre mass: safety 0.1 as before); with fibre mass 12 at 2 mm and the clamped
+    holder's 1e5 Pa the contact sets the step, at the budget (omega dt / 2 = 0.9 with four contacts
+    on a node) and with the stiffness that keeps 1e5 Pa below 10% of the ply; the former advice
+    (safety 0.5) broke that budget. Unclamped (Case A, automatic: 1e4 Pa) the same rule gives a
+    ten times softer contact and, at 8 mm, a 2.5 times longer step."""
     from jaxform.forming import numerics
 
-    _, stable, n = _numerics("case-a-woven-nlbm", 4.0)
+    _, stable, n = _numerics("case-a-woven-nlbm", 4.0, "numerics.fibre_mass_scaling=1")
     assert (n.governed_by, n.safety, n.dt_max) == ("shell", 0.1, pytest.approx(0.75 * stable))
     assert n.budget < 0.9
-    case, stable, n = _numerics("case-a-woven-nlbm", 2.0, "numerics.fibre_mass_scaling=12")
+    case, stable, n = _numerics("case-a-woven-nlbm", 2.0, "numerics.fibre_mass_scaling=12",
+                                "contact.expected_pressure_Pa=1e5")
     assert n.governed_by == "contact" and n.dt_max < 0.75 * stable
     assert n.budget == pytest.approx(numerics.STEP_BUDGET)
     rho, h = float(_areal_mass(case)), case.ply_thickness
@@ -178,6 +181,18 @@ def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_sta
     assert 0.5 * np.sqrt(omega2) == pytest.approx(0.9)
     _, _, old = _numerics("case-a-woven-nlbm", 2.0, "numerics.fibre_mass_scaling=12", "contact.safety=0.5")
     assert old.governed_by == "shell" and old.budget > 1.0
+    # the expected pressure: given, clamped (Case B) or not (Case A)
+    assert numerics.expected_pressure(case) == (1e5, "given")
+    assert numerics.expected_pressure(cases.load("case-b-woven-nlbm"))[0] == numerics.EXPECTED_PRESSURE == 1e5
+    assert numerics.expected_pressure(cases.load("case-a-ncf-nlbm"))[0] == numerics.GAP_EXPECTED_PRESSURE == 1e4
+    steps = {}
+    for p in ("1e4", "1e5"):
+        case, stable, n = _numerics("case-a-woven-nlbm", 8.0, "numerics.fibre_mass_scaling=12",
+                                    f"contact.expected_pressure_Pa={p}")
+        assert n.budget == pytest.approx(numerics.STEP_BUDGET) and f"at {float(p):.3g} Pa" in n.why
+        assert n.safety * rho / n.dt_max**2 == pytest.approx(1.02 * float(p) / (0.1 * h))
+        steps[p] = n.dt_max
+    assert steps["1e4"] / steps["1e5"] > 2.5
 
 
 def _areal_mass(case):

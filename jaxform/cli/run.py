@@ -204,6 +204,11 @@ def report(result, written, out, stream=None):
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
               f"{safety}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
               f"({n.get('speed_choice', 'given')})", file=stream)
+        pen = n.get("max_penetration_ply")
+        if pen is not None and pen > n["penetration_limit_ply"]:
+            print(f"  warning: a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set "
+                  f"for {n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the "
+                  "expected one; raise contact.expected_pressure_Pa for a stiffer contact", file=stream)
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)

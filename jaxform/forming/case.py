@@ -24,10 +24,13 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                jaxform.forming.numerics.quasi_static_speed), ramp_fraction, frames
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety ("auto" or a number in
                (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
-               damping_ratio, optional self_contact (default true: folds lie on themselves)
-    [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto" or >= 1,
-               default 1 = off: inertia added to fibre stretching only, the membrane limit of
-               the step grows by that factor; see jaxform.fibre_mass), optional
+               damping_ratio, optional self_contact (default true: folds lie on themselves),
+               optional expected_pressure_Pa ("auto", the default, or > 0: the contact pressure
+               the penalty keeps below 10% of the ply, jaxform.forming.numerics.expected_pressure)
+    [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto", the
+               default: jaxform.forming.numerics.auto_fibre_mass; or a number >= 1, 1 = off:
+               inertia added to fibre stretching only, the membrane limit of the step grows by
+               that factor; see jaxform.fibre_mass), optional
                fibre_mass_momentum_term (default false: the exact term of a position-dependent mass)
 
 No I/O and no physics here: TOML text is parsed and written by :mod:`jaxform.io.case_file`, the
@@ -40,6 +43,7 @@ import math
 from typing import Any
 
 from jaxform import units
+from jaxform.contact import stable_damping_ratio
 from jaxform.forming.speed import quasi_static_speed
 
 BENDING_MODELS = ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")
@@ -111,13 +115,15 @@ class ContactSpec:
     stability ``safety`` (``(omega_c dt)^2`` of one contact; ``None``: automatic, chosen with the
     time step by :func:`jaxform.forming.numerics.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
     damping ratio; ``self_contact``: every ply with itself and the plies not next to it
-    (:mod:`jaxform.self_contact`, on by default)."""
+    (:mod:`jaxform.self_contact`, on by default); ``expected_pressure``: Pa (``None``: automatic,
+    :func:`jaxform.forming.numerics.expected_pressure`)."""
 
     penalty_stiffness: float | None
     safety: float | None
     slip_velocity_fraction: float
     damping_ratio: float
     self_contact: bool = True
+    expected_pressure: float | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -136,7 +142,7 @@ class Case:
     contact: ContactSpec
     dtype: str
     mass_scaling: float
-    fibre_mass_scaling: float | None = 1.0  # None: automatic (jaxform.forming.numerics.auto_fibre_mass)
+    fibre_mass_scaling: float | None = None  # None: automatic (jaxform.forming.numerics.auto_fibre_mass)
     fibre_mass_momentum_term: bool = False  # jaxform.fibre_mass.geometric_force
 
     @property
@@ -184,7 +190,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
-                "self_contact": ("bool", False)},
+                "self_contact": ("bool", False), "expected_pressure_Pa": ("auto", False)},
     "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False),
                  "fibre_mass_momentum_term": ("bool", False)},
 }
@@ -359,8 +365,10 @@ def _build(d) -> Case:
     if safety != "auto" and not 0 < safety < 1:
         raise _err("contact.safety", safety, "must lie in (0, 1) or be 'auto'")
     _positive(d, "slip_velocity_fraction", "contact")
+    if (pe := c.get("expected_pressure_Pa", "auto")) != "auto" and not (math.isfinite(pe) and pe > 0):
+        raise _err("contact.expected_pressure_Pa", pe, "must be a finite number > 0 (Pa) or 'auto'")
     # 'auto' chooses at most AUTO_SAFETY_MAX (jaxform.forming.numerics.contact_numerics)
-    zeta_stable = _stable_damping_ratio(AUTO_SAFETY_MAX if safety == "auto" else safety) if k == "auto" else math.inf
+    zeta_stable = stable_damping_ratio(AUTO_SAFETY_MAX if safety == "auto" else safety) if k == "auto" else math.inf
     if not 0 <= c["damping_ratio"] <= min(1.0, zeta_stable):
         raise _err("contact.damping_ratio", c["damping_ratio"],
                    f"must lie in [0, {min(1.0, zeta_stable):.3g}]: 1 is critical damping (beyond it the contact "
@@ -368,13 +376,13 @@ def _build(d) -> Case:
                                       f"to {zeta_stable:.3g}" if zeta_stable < 1.0 else ""))
     contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=None if safety == "auto" else safety,
                                slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"],
-                               self_contact=c.get("self_contact", True))
+                               self_contact=c.get("self_contact", True), expected_pressure=None if pe == "auto" else pe)
 
     n = d["numerics"]
     if n["dtype"] not in ("float32", "float64"):
         raise _err("numerics.dtype", n["dtype"], "must be 'float32' or 'float64'")
     _positive(d, "mass_scaling", "numerics")
-    fms = n.get("fibre_mass_scaling", 1.0)
+    fms = n.get("fibre_mass_scaling", "auto")
     if fms != "auto" and not (math.isfinite(fms) and fms >= 1.0):
         raise _err("numerics.fibre_mass_scaling", fms, "must be a number >= 1 (1 = off) or 'auto'")
 
@@ -393,16 +401,6 @@ def _build(d) -> Case:
 AUTO_SAFETY_MAX = 0.81
 """The largest contact safety ``(omega_c dt)^2`` the automatic choice can make: the step budget
 ``(2 x 0.9)^2`` shared by :data:`jaxform.forming.numerics.STACKED_CONTACTS` = 4 contacts."""
-
-
-def _stable_damping_ratio(safety: float) -> float:
-    """Largest contact damping ratio a stable explicit step allows with the automatic stiffness.
-
-    The automatic penalty stiffness is ``k = safety rho_A / dt^2``, so the contact oscillator has
-    ``omega dt = sqrt(safety)``; central differences with velocity damping stay stable while
-    ``omega dt <= 2 (sqrt(1 + zeta^2) - zeta)``, i.e. ``zeta <= (4 - safety) / (4 sqrt(safety))``.
-    """
-    return (4.0 - safety) / (4.0 * math.sqrt(safety))
 
 
 def _check_shear_poly(coeffs) -> None:
@@ -508,10 +506,10 @@ def to_dict(case: Case) -> dict:
                     "frames": p.frames},
         "contact": {"penalty_stiffness_Pa_per_m": "auto" if c.penalty_stiffness is None else c.penalty_stiffness,
                     "safety": "auto" if c.safety is None else c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
-                    "damping_ratio": c.damping_ratio, "self_contact": c.self_contact},
+                    "damping_ratio": c.damping_ratio, "self_contact": c.self_contact,
+                    "expected_pressure_Pa": "auto" if c.expected_pressure is None else c.expected_pressure},
         "numerics": numerics,
     }
-
 
 
 def ply_heights(case: Case) -> list[float]:

@@ -152,6 +152,11 @@ def physical_causes(x, fl, bounds) -> list[str]:
         causes.append(f"fibre strain {strain:.3g} beyond {b.fibre_strain:g} (the fibres carry < 0.01)")
     if not speed <= b.speed:
         causes.append(f"a node moves at {speed:.3g} m/s, beyond {b.speed:.3g} m/s (100 x the punch speed)")
+    pen = float(fl.get("max_penetration", 0.0))
+    if not pen <= b.penetration:
+        causes.append(f"a node penetrated a tool or ply by {pen * 1e3:.3g} mm, beyond {b.penetration * 1e3:.3g} mm "
+                      "(half the ply): the contact is too soft for this case's pressures (raise "
+                      "contact.expected_pressure_Pa)")
     lo, hi = x.min(axis=0), x.max(axis=0)
     if not (np.all(lo >= np.asarray(b.box_lo)) and np.all(hi <= np.asarray(b.box_hi))):
         far = max(float(np.max(np.asarray(b.box_lo) - lo)), float(np.max(hi - np.asarray(b.box_hi))))

@@ -11,7 +11,7 @@ from jaxform.metrics.wrinkles import rms_fibre_moment
 from jaxform.shell import fibre_curvatures, fibre_vectors, shear_angle
 
 SCALARS = ("punch_force", "punch_displacement", "holder_force", "holder_dz", "contact_energy", "friction_power",
-           "max_fibre_strain", "max_node_speed")
+           "max_fibre_strain", "max_node_speed", "max_penetration")
 """Keys of :func:`state_fields` that are scalars (sampled as histories, not written as frames)."""
 ENERGY_KEYS = ("kinetic", "tension", "shear", "bending", "gravity_work", "external_work", "boundary_work",
                "damping_work")
@@ -19,7 +19,7 @@ ENERGY_KEYS = ("kinetic", "tension", "shear", "bending", "gravity_work", "extern
 HISTORY_KEYS = {"t": "t_s", "step": "step", "punch_force": "punch_force_N", "punch_displacement": "punch_displacement_m",
                 "holder_force": "holder_force_N", "holder_dz": "holder_dz_m", "contact_energy": "contact_energy_J",
                 "friction_power": "friction_power_W", "max_fibre_strain": "max_fibre_strain",
-                "max_node_speed": "max_node_speed_m_per_s", **{k: f"{k}_J" for k in ENERGY_KEYS}}
+                "max_node_speed": "max_node_speed_m_per_s", "max_penetration": "max_penetration_m", **{k: f"{k}_J" for k in ENERGY_KEYS}}
 """Sampled quantity -> its key in a run's history (``FormingResult.history``, ``summary.json``): name_unit."""
 
 
@@ -64,7 +64,9 @@ def state_fields(model, state, ply_id, n_plies: int):
     ``punch_force`` () N (vertical reaction on the punch, positive resisting its descent),
     ``punch_displacement`` () m (downwards positive), ``holder_force`` () N, ``holder_dz`` () m,
     ``contact_energy`` () J, ``friction_power`` () W, ``max_fibre_strain`` () largest ``|g_f| - 1``
-    of any element, ``max_node_speed`` () m/s (the run's physical health, :mod:`jaxform.forming.driver`).
+    of any element, ``max_node_speed`` () m/s, ``max_penetration`` () m: the deepest penetration of
+    a node into a tool (from its gap) or a ply (its pressure over the stiffness) (the run's physical
+    health, :mod:`jaxform.forming.driver`).
     """
     shell = model.shell
     mesh = shell.mesh
@@ -83,17 +85,21 @@ def state_fields(model, state, ply_id, n_plies: int):
            "max_node_speed": jnp.sqrt(jnp.max(jnp.sum(state.v * state.v, axis=-1)))}
     pressure = jnp.zeros((n,), dtype)
     phis, tool = [], {}
+    pen = jnp.zeros((), dtype)
     for i, (load, ls) in enumerate(zip(model.loads[:3], state.loads[:3])):
         dz, vel = _tool_pose(load, state.t, ls)
         res = contact.tool_contact(load.tool, x, state.v, load.offset, load.area, load.params, dz=dz,
                                    tool_velocity=vel, active=load.active)
         pressure = pressure + res.pressure
+        pen = jnp.maximum(pen, jnp.max(jnp.where(jnp.asarray(load.active) > 0, -res.gap, 0.0)))
         phis.append(res.gap + load.offset)
         tool[i] = (res, dz)
     for load, ls in zip(model.loads[3:], state.loads[3:]):
         slave, p = load.node_pressure(x, state.v, ls)
         pressure = pressure.at[slave].add(p)
+        pen = jnp.maximum(pen, jnp.max(p) / load.params.stiffness)
     out["contact_pressure"] = pressure
+    out["max_penetration"] = pen
     h = jnp.asarray(shell.fabrics[0].thickness, dtype)
     i = jnp.asarray(ply_id, dtype)
     out["deviation"] = jnp.minimum(phis[PUNCH] - (i - 0.5) * h, phis[DIE] - (n_plies - i + 0.5) * h)

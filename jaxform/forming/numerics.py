@@ -67,7 +67,27 @@ AUTO_SAFETY = 0.1
 """Automatic contact safety ``(omega_c dt)^2`` where it gives a stiff enough contact."""
 PENETRATION = (EXPECTED_PRESSURE, MAX_PENETRATION)
 """``(pressure Pa, fraction of the ply thickness)``: the automatic contact keeps the penetration
-under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it)."""
+under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it); the
+pressure is that of a clamped holder (:func:`expected_pressure`)."""
+GAP_EXPECTED_PRESSURE = 1.0e4
+"""Pa: the expected pressure where nothing clamps the blank (a holder at a fixed gap, Case A):
+the tools then press the fabric only with its own tension and bending. Largest nodal contact
+pressure over the frames of Case A at 62.5 mm/s: woven NLBM 1.7 kPa at 8 mm, 0.91 kPa at 4 mm;
+woven LBM B_inf 3.2 kPa at 4 mm. A run that exceeds it is seen: its deepest penetration is
+recorded, and beyond half the ply it stops (:func:`jaxform.forming.rig.health_bounds`)."""
+
+
+def expected_pressure(case: Case) -> tuple[float, str]:
+    """``(pressure Pa, why)``: the contact pressure the automatic penalty keeps below
+    ``MAX_PENETRATION`` of the ply (``contact.expected_pressure_Pa``; ``"auto"``: :data:`GAP_EXPECTED_PRESSURE`
+    with a holder at a fixed gap, :data:`EXPECTED_PRESSURE` with a clamped one (5x the mean
+    pressure of the paper's 1000 N on Case B's flange, where wrinkle crests carry it)). A softer
+    contact allows a longer step; the run checks its penetration (:mod:`jaxform.forming.driver`)."""
+    if case.contact.expected_pressure is not None:
+        return float(case.contact.expected_pressure), "given"
+    if case.holder.mode == "gap":
+        return GAP_EXPECTED_PRESSURE, "auto: nothing clamps the blank (holder at a fixed gap)"
+    return EXPECTED_PRESSURE, "auto: a clamped holder"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -94,7 +114,8 @@ class ContactNumerics:
 def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float) -> ContactNumerics:
     """Choose the time step and the contact safety together (the automatic numerics of contact).
 
-    The contact must be stiff enough: ``k >= k_need = p / (f h)`` (:data:`PENETRATION`), and the
+    The contact must be stiff enough: ``k >= k_need = p / (f h)`` (``p`` from :func:`expected_pressure`,
+    ``f`` :data:`MAX_PENETRATION`), and the
     step stable with :data:`STACKED_CONTACTS` contacts on a node: ``(omega_s dt)^2 + n_c safety <=
     (2 STEP_BUDGET)^2`` with ``omega_s = 2 / stable`` the shell's (fibre mass included) and
     ``safety = k dt^2 / rho_A``. Automatic safety (``contact.safety = "auto"``): the step is
@@ -107,7 +128,8 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
     """
     c = case.contact
     rho = float(np.max(np.asarray(fabrics[0].areal_mass))) * float(case.mass_scaling)
-    k_lim = PENETRATION[0] / (PENETRATION[1] * float(case.ply_thickness))
+    p_exp = expected_pressure(case)[0]
+    k_lim = p_exp / (MAX_PENETRATION * float(case.ply_thickness))
     k_need = 1.02 * k_lim  # 2% stiffer, so that rounding never trips contact_params' penetration check
     w_s2 = (2.0 / stable) ** 2
     n_c, lim = STACKED_CONTACTS, (2.0 * STEP_BUDGET) ** 2
@@ -137,14 +159,14 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
         s_ = max(AUTO_SAFETY, s_need)
         return ContactNumerics(dt0, s_, "shell", budget(dt0, s_),
                                f"step {dt_safety:g} x the shell's stable step; contact safety {s_:.3g} "
-                               f"(penetration below {PENETRATION[1]:g} h at {PENETRATION[0]:.0e} Pa)")
+                               f"(penetration below {MAX_PENETRATION:g} h at {p_exp:.3g} Pa)")
     dt_ = 2.0 * STEP_BUDGET / math.sqrt(w_s2 + n_c * k_need / rho)
     s_ = k_need * dt_**2 / rho
     return ContactNumerics(dt_, s_, "contact", budget(dt_, s_),
-                           f"a contact stiff enough for a penetration below {PENETRATION[1]:g} h at "
-                           f"{PENETRATION[0]:.0e} Pa and stable with {n_c} contacts on a node needs a step of "
+                           f"a contact stiff enough for a penetration below {MAX_PENETRATION:g} h at "
+                           f"{p_exp:.3g} Pa and stable with {n_c} contacts on a node needs a step of "
                            f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}")
 
 
 __all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
-           "AUTO_SAFETY", "PENETRATION", "ContactNumerics", "contact_numerics"]
+           "AUTO_SAFETY", "PENETRATION", "GAP_EXPECTED_PRESSURE", "expected_pressure", "ContactNumerics", "contact_numerics"]

@@ -21,7 +21,7 @@ _BASE = {
     "process": {"stroke_mm": 50.0, "speed_mm_per_s": "auto", "ramp_fraction": 0.1, "frames": 11},
     "contact": {"penalty_stiffness_Pa_per_m": "auto", "safety": "auto", "slip_velocity_fraction": 0.01,
                 "damping_ratio": 0.1},
-    "numerics": {"dtype": "float32", "mass_scaling": 1.0},
+    "numerics": {"dtype": "float32", "mass_scaling": 1.0, "fibre_mass_scaling": "auto"},
 }
 _BENDING_TEXT = {
     "nlbm": "non-linear (Voce) bending", "lbm-init": "linear bending, B_init", "lbm-41": "linear bending, B_41.5",

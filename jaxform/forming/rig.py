@@ -15,8 +15,9 @@ ply n the die, middle plies only their neighbours. Every tool contact acts at th
 Numerics (documented choices):
 * time step and contact stiffness chosen together (:func:`jaxform.forming.numerics.contact_numerics`): ``dt_safety`` (0.75)
   times the shell's stable estimate, unless a contact stiff enough to keep the penetration below
-  10% of the ply at 1e5 Pa, stable with four contacts pressing one node (a fold under the holder),
-  needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
+  10% of the ply at the case's expected pressure (1e4 Pa with a holder at a gap, 1e5 Pa clamped:
+  :func:`jaxform.forming.numerics.expected_pressure`), stable with four contacts pressing one node
+  (a fold under the holder), needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
 * gravity :data:`jaxform.units.GRAVITY` along -z, divided by the mass scaling so the physical
   weight is kept;
 * friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed, raised
@@ -39,7 +40,7 @@ import numpy as np
 from jaxform import contact, integrate, units
 from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
 from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNumerics, auto_fibre_mass,
-                                      contact_numerics)
+                                      contact_numerics, expected_pressure)
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
 from jaxform.shell import Shell, stable_time_step
@@ -101,27 +102,31 @@ class HealthBounds:
     Attributes:
         fibre_strain: largest ``|fibre strain|`` of any element (the fibres' 3 GPa modulus keeps
             real strains below 1%); speed: largest node speed, m/s; box_lo, box_hi: (3,) corners
-            of the box the part stays in, m.
+            of the box the part stays in, m; penetration: deepest penetration of a node into a
+            tool or ply, m.
     """
 
     fibre_strain: float
     speed: float
     box_lo: tuple
     box_hi: tuple
+    penetration: float = math.inf
 
 
 def health_bounds(case: Case) -> HealthBounds:
     """The bounds of :class:`HealthBounds` for a case: fibre strain 10% (ten times what the fibres
     carry), node speed 100 times the punch speed (at least 10 m/s: a snap-through of the flange
     stays well below), and a box of twice the blank's half-size across, from the punch's lowest
-    reach minus a blank half-size below to the holder's top plus a blank half-size above."""
+    reach minus a blank half-size below to the holder's top plus a blank half-size above; a
+    penetration of half the ply thickness (five times what the automatic contact allows at its
+    expected pressure: the pressures exceed it and the contact is too soft)."""
     half = 0.5 * case.blank_size
     t = case.tools
     top = (case.holder.gap or case.stack_thickness) + t.holder_thickness + half
     bottom = -(case.process.stroke + t.die_thickness + half)
     return HealthBounds(fibre_strain=0.1, speed=max(100.0 * case.process.speed, 10.0),
-                        box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top))
-
+                        box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top),
+                        penetration=0.5 * float(case.ply_thickness))
 
 class Rig(NamedTuple):
     """A built run: fixed :class:`~jaxform.model.Model`, initial :class:`~jaxform.model.State`,
@@ -288,6 +293,7 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     speed = float(case.process.speed)
     n_if = 2 if case.n_plies > 1 else 1  # frictional contacts per node (stack: tool + ply, or two plies)
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
+                  expected_pressure=expected_pressure(case)[0],
                   damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=n_if)
     params_tool = contact.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
     params_ply = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)

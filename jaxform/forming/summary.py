@@ -7,8 +7,10 @@ import math
 import jax
 import numpy as np
 
+from jaxform.contact import MAX_PENETRATION
 from jaxform.forming.case import to_dict
 from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS
+from jaxform.forming.numerics import expected_pressure
 from jaxform.forming.rig import RunInfo
 
 
@@ -63,13 +65,19 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
     return out
 
 
-def _step_choice(info) -> dict:
-    """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`)."""
+def _step_choice(info, history) -> dict:
+    """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`),
+    and the deepest penetration the run's samples saw, as a fraction of the ply thickness (the
+    automatic contact keeps it below :data:`jaxform.contact.MAX_PENETRATION` at the expected pressure)."""
     n = getattr(info, "numerics", None)
     if n is None:
         return {}
+    p, why = expected_pressure(info.case)
+    pen = history.get("max_penetration_m")
     return {"dt_governed_by": n.governed_by, "contact_safety": n.safety, "step_budget": n.budget,
-            "step_choice": n.why}
+            "step_choice": n.why, "expected_pressure_Pa": p, "expected_pressure_choice": why,
+            "max_penetration_ply": float(np.max(pen)) / float(info.case.ply_thickness) if pen is not None and len(pen)
+            else None, "penetration_limit_ply": MAX_PENETRATION}
 
 
 def summarize(result) -> dict:
@@ -115,7 +123,7 @@ def summarize(result) -> dict:
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,
                      "punch_speed_m_per_s": float(case.process.speed),
-                     "speed_choice": case.process.speed_choice or "given", **_step_choice(info)},
+                     "speed_choice": case.process.speed_choice or "given", **_step_choice(info, h)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,

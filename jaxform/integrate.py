@@ -328,10 +328,14 @@ def describe_failure(state: State, model: Model) -> str:
     dt = float(model.dt)
     fm = 1.0 if model.fibre_mass is None else model.fibre_mass.factor
     stable = stable_time_step(model.shell, model.mass_scale, safety=1.0, fibre_mass_factor=fm)
+    pump = "" if fm == 1.0 or model.fibre_mass.geometric else (
+        f" With a fibre mass (x{fm:g}) but not its momentum term, turning elements can also gain energy from "
+        "the position-dependent mass: turn the term on (forming cases: numerics.fibre_mass_momentum_term = true) "
+        "or lower the factor (numerics.fibre_mass_scaling).")
     return (f"simulation failed at step {bad} (t = {bad * dt:.6e} s): {failure_cause(state)}. "
             f"Likely cause: the time step {dt:.3e} s is too large for the mesh (stable estimate of the "
             f"shell {stable:.3e} s{f', fibre mass x{fm:g}' if fm != 1.0 else ''}; contact stiffness adds to it), "
-            "or a distorted/inverted element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh.")
+            "or a distorted/inverted element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh." + pump)
 
 
 def check(state: State, frames: Frames, model: Model):

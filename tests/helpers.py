@@ -2,10 +2,11 @@
 small stand-in cantilever models that the calibration scripts load with ``--simulate helpers:NAME``."""
 import numpy as np
 
-FAST = "process.speed_mm_per_s=500"
-"""The presets' former punch speed: for tests of wiring, contact, gradients and output, where the
-automatic quasi-static speed (4-8x slower, :func:`jaxform.forming.numerics.quasi_static_speed`)
-would only cost time."""
+FAST = ("process.speed_mm_per_s=500", "numerics.fibre_mass_scaling=1", "contact.expected_pressure_Pa=1e5")
+"""The former numerics of the presets (500 mm/s, no fibre mass, a contact stiff for 1e5 Pa): tests of
+wiring, contact and gradients pin them (short, one program each); the automatic numerics have their own tests."""
+FAST_SET = tuple(x for kv in FAST for x in ("--set", kv))
+""":data:`FAST` as ``jaxform`` command-line options."""
 
 
 def central_difference(f, x, h, *, index=None, direction=None):

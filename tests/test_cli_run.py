@@ -7,10 +7,10 @@ import numpy as np
 import pytest
 
 from jaxform.cli import main
+from helpers import FAST_SET
 
 # the presets' former 500 mm/s, not the automatic quasi-static speed: these tests check the outputs
-FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--set",
-        "process.speed_mm_per_s=500", "--quiet"]
+FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", *FAST_SET, "--quiet"]
 FIELDS = ("displacement_m", "shear_angle_deg", "fibre_strain", "bending_moment_N", "M_f_rms_N", "contact_pressure_Pa",
           "deviation_m", "ply_id")
 
@@ -31,8 +31,8 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
     assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
     assert n["speed_choice"] == "given" and "punch 500 mm/s (given)" in text
-    # the contact's expected pressure (no clamping: 1e4 Pa) and the deepest penetration seen, within it
-    assert n["expected_pressure_Pa"] == 1e4 and n["expected_pressure_choice"].startswith("auto")
+    # the contact's expected pressure (given here) and the deepest penetration seen, within its limit
+    assert n["expected_pressure_Pa"] == 1e5 and n["expected_pressure_choice"] == "given"
     assert 0 < n["max_penetration_ply"] < n["penetration_limit_ply"] == 0.1 and "penetrated" not in text
     assert len(s["history"]["max_penetration_m"]) == len(s["history"]["t_s"])
     for key in ("max_ke_ie", "max_shear_angle_deg", "wall_time_s"):

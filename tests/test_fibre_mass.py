@@ -299,5 +299,6 @@ def test_a_spinning_sheet_keeps_its_energy_only_with_the_position_dependent_mass
     e0 = float(state.energies.kinetic + state.energies.internal)
     assert np.max(np.abs(total - e0)) <= 0.015 * e0
     without = model.replace(fibre_mass=dataclasses.replace(model.fibre_mass, geometric=False))
-    with pytest.raises(SimulationError, match="energy blow-up"):
+    with pytest.raises(SimulationError, match="energy blow-up") as err:
         simulate(without, init_state(without, v=v), n_frames=20, every=every)
+    assert "numerics.fibre_mass_momentum_term = true" in str(err.value)  # the failure names the remedy

@@ -17,7 +17,7 @@ def _coarse(name, size_mm=25.0, **keys):
     case = cases.with_element_size(cases.load(name), size_mm * 1e-3)
     # the presets' former 500 mm/s (the automatic quasi-static speed is 4-8x slower): these tests
     # check wiring, contact and gradients, not quasi-statics
-    return cases.apply_overrides(case, [FAST, *(f"{k.replace('__', '.')}={v}" for k, v in keys.items())])
+    return cases.apply_overrides(case, [*FAST, *(f"{k.replace('__', '.')}={v}" for k, v in keys.items())])
 
 
 def test_build_wires_case_b():

@@ -16,18 +16,18 @@ from jaxform import cases, forming
 from jaxform.cli import main
 from jaxform.cli.sweep import member_names, parse_vary, split_values
 from jaxform.forming import batch
-from helpers import FAST
+from helpers import FAST, FAST_SET
 
 # the 1e13 Pa/m members are meant to blow up: build warns about them, as it should
 pytestmark = pytest.mark.filterwarnings("ignore:forming.build. the time step and contact stiffness:RuntimeWarning")
 
-BASE = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--set", FAST]
+BASE = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", *FAST_SET]
 VARY = ["--vary", "fabric.friction_tool=0.2,0.3", "--vary", "contact.penalty_stiffness_Pa_per_m=auto,1e13,1e3"]
 
 
 def _case(*overrides):
     return cases.resolve("case-a-woven-nlbm", element_size=25e-3,
-                         overrides=[FAST, "process.stroke_mm=4", "process.frames=3", *overrides])
+                         overrides=[*FAST, "process.stroke_mm=4", "process.frames=3", *overrides])
 
 
 def _rows(path):

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 from jaxform.cli import main
+from helpers import FAST_SET
 from jaxform.io.surface import UnitsWarning, read_point_cloud, read_surface, write_vtu
 from _surfaces import draped_sheet
 
@@ -142,8 +143,8 @@ def test_read_surface_formats_and_units(tmp_path):
 def small_run(tmp_path_factory):
     """A 4 mm stroke of case A (25 mm elements, 3 frames): frames_00002.vtu is the last."""
     out = tmp_path_factory.mktemp("run") / "a"
-    assert main(["run", "case-a-woven-nlbm", "--out", str(out), "--element-size-mm", "25", "--set",
-                 "process.speed_mm_per_s=500", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
+    assert main(["run", "case-a-woven-nlbm", "--out", str(out), "--element-size-mm", "25", *FAST_SET,
+                 "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
     return out
 
 
@@ -191,8 +192,8 @@ def test_each_ply_of_a_stack_against_the_tool_it_lies_on(tmp_path):
     """Case B (two plies): ply i lies at (i - 1/2) h from the punch and (n - i + 1/2) h from the die;
     one d_crit for both sides called the whole flange of ply 1 bridging (61876 of 62500 mm^2)."""
     run = tmp_path / "b"
-    assert main(["run", "case-b-woven-nlbm", "--out", str(run), "--element-size-mm", "25", "--set",
-                 "process.speed_mm_per_s=500", "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
+    assert main(["run", "case-b-woven-nlbm", "--out", str(run), "--element-size-mm", "25", *FAST_SET,
+                 "--set", "process.stroke_mm=4", "--set", "process.frames=3", "--quiet"]) == 0
     frame = meshio.read(run / "frames_00002.vtu")
     ply_id = frame.point_data["ply_id"].ravel()
     for ply in (1, 2):

@@ -21,7 +21,7 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                optional punch_mesh = "file.stl", punch_mesh_units, punch_mesh_cell_mm
     [holder]   mode = "gap" | "force"; gap_mm (gap mode); force_N, mass_kg (force mode)
     [process]  stroke_mm, speed_mm_per_s (simulated punch speed, or "auto": the quasi-static speed of
-               jaxform.forming.numerics.quasi_static_speed), ramp_fraction, frames
+               jaxform.forming.speed.quasi_static_speed), ramp_fraction, frames
     [contact]  penalty_stiffness_Pa_per_m ("auto" or a number), safety ("auto" or a number in
                (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
                damping_ratio, optional self_contact (default true: folds lie on themselves),

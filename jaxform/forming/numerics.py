@@ -65,10 +65,6 @@ under the holder, a stack) has two, and the highest mode of a chain of such laye
 ``omega^2 = 4 k / m`` (Gershgorin), so 4 covers any depth of stacking."""
 AUTO_SAFETY = 0.1
 """Automatic contact safety ``(omega_c dt)^2`` where it gives a stiff enough contact."""
-PENETRATION = (EXPECTED_PRESSURE, MAX_PENETRATION)
-"""``(pressure Pa, fraction of the ply thickness)``: the automatic contact keeps the penetration
-under this pressure below this fraction (:func:`jaxform.contact.contact_params` checks it); the
-pressure is that of a clamped holder (:func:`expected_pressure`)."""
 GAP_EXPECTED_PRESSURE = 1.0e4
 """Pa: the expected pressure where nothing clamps the blank (a holder at a fixed gap, Case A):
 the tools then press the fabric only with its own tension and bending. Largest nodal contact
@@ -169,4 +165,4 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
 
 
 __all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
-           "AUTO_SAFETY", "PENETRATION", "GAP_EXPECTED_PRESSURE", "expected_pressure", "ContactNumerics", "contact_numerics"]
+           "AUTO_SAFETY", "GAP_EXPECTED_PRESSURE", "expected_pressure", "ContactNumerics", "contact_numerics"]

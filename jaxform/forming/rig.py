@@ -128,6 +128,7 @@ def health_bounds(case: Case) -> HealthBounds:
                         box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top),
                         penetration=0.5 * float(case.ply_thickness))
 
+
 class Rig(NamedTuple):
     """A built run: fixed :class:`~jaxform.model.Model`, initial :class:`~jaxform.model.State`,
     host facts :class:`RunInfo` (unpacks as ``model, state, info``)."""

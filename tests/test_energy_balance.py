@@ -20,7 +20,8 @@ N_STEPS = 3000
 
 def _case(*overrides):
     case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.0125)
-    return cases.apply_overrides(case, [*FAST, "process.stroke_mm=10", "process.frames=3", *overrides])
+    return cases.apply_overrides(case, [*FAST, "contact.self_contact=true", "process.stroke_mm=10", "process.frames=3",
+                                         *overrides])
 
 
 def _energies(case, dtype, n=N_STEPS, dt=None):

@@ -21,7 +21,7 @@ def _coarse(name, size_mm=25.0, **keys):
 
 
 def test_build_wires_case_b():
-    case = _coarse("case-b-ncf-nlbm", process__frames=3)
+    case = _coarse("case-b-ncf-nlbm", process__frames=3, contact__self_contact="true")
     model, state, info = forming.build(case)
     h = case.ply_thickness
     n = len(info.x0)

@@ -302,3 +302,37 @@ def test_a_spinning_sheet_keeps_its_energy_only_with_the_position_dependent_mass
     with pytest.raises(SimulationError, match="energy blow-up") as err:
         simulate(without, init_state(without, v=v), n_frames=20, every=every)
     assert "numerics.fibre_mass_momentum_term = true" in str(err.value)  # the failure names the remedy
+
+
+def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
+    """A forming run whose blank spins in-plane and stretches (NCF, 25 mm, fibre mass 12 without
+    its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792) is
+    run again from its start with it, the run completes, and the summary says from which step and
+    why. The same rig at rest never pays for the term."""
+    import dataclasses
+
+    from jaxform import cases, forming
+
+    case = cases.apply_overrides(cases.with_element_size(cases.load("case-a-ncf-nlbm"), 25e-3), [
+        "process.stroke_mm=4", "process.frames=2", "numerics.fibre_mass_scaling=12", "numerics.dtype=float64",
+        "contact.self_contact=false"])
+    model, state, info = forming.build(case, samples_per_frame=8)
+    assert model.fibre_mass is not None and not model.fibre_mass.geometric
+    r = np.asarray(state.x) - np.asarray(state.x).mean(axis=0)
+    w, a = 40.0, 3.0  # rad/s (corners at 7 m/s, 5.4 rad over the 134 ms stroke) and m/s of fibre stretching
+    v = np.stack([-w * r[:, 1] + a * np.sin(np.pi * r[:, 0] / 0.125), w * r[:, 0] + a * np.sin(np.pi * r[:, 1] / 0.125),
+                  np.zeros(len(r))], 1)
+    p = np.where(np.asarray(model.fixed), 0.0, np.asarray(model.mass)[:, None] * v).T
+    e = dataclasses.replace(state.energies, kinetic=jnp.asarray(0.5 * np.sum(np.asarray(model.mass) * np.sum(v**2, 1))))
+    spun = dataclasses.replace(state, v=jnp.asarray(v), momentum=jnp.asarray(p), energies=e, scale_max=e.scale())
+    res = forming.run(forming.Rig(model, spun, info), catch=True)
+    assert res.complete, res.reason
+    sw = res.momentum_term_from
+    assert sw is not None and 0 < sw["step"] < info.n_steps and "energy" in sw["cause"]
+    assert res.model.fibre_mass.geometric
+    n = res.summary["numerics"]
+    assert n["fibre_mass_momentum_term"] and n["fibre_mass_momentum_term_from_step"] == sw["step"]
+    assert "switched on by the driver" in n["fibre_mass_momentum_term_choice"]
+    calm = forming.run(forming.Rig(model, state, info), catch=True)
+    assert calm.complete and calm.momentum_term_from is None and not calm.model.fibre_mass.geometric
+    assert calm.summary["numerics"]["fibre_mass_momentum_term_choice"].startswith("off")

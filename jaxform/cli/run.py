@@ -200,7 +200,9 @@ def report(result, written, out, stream=None):
         fm = n.get("fibre_mass_scaling", 1.0)
         safety = "from the given stiffness" if n.get("contact_safety") is None else f"{n['contact_safety']:.3g}"
         mass = "off" if fm == 1.0 else f"x{fm:g}" + (" (auto)" if n.get("fibre_mass_choice") == "auto" else "") + (
-            " with its momentum term" if n.get("fibre_mass_momentum_term") else "")
+            " with its momentum term" if n.get("fibre_mass_momentum_term") else "") + (
+            f" (from step {n['fibre_mass_momentum_term_from_step']}: a chunk failed without it)"
+            if n.get("fibre_mass_momentum_term_from_step") is not None else "")
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
               f"{safety}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
               f"({n.get('speed_choice', 'given')})", file=stream)

@@ -80,6 +80,21 @@ def _step_choice(info, history) -> dict:
             else None, "penetration_limit_ply": MAX_PENETRATION}
 
 
+def _momentum_term(result) -> dict:
+    """The summary's ``fibre_mass_momentum_term`` (whether the run ended with it) and why."""
+    given = bool(getattr(result.info.case, "fibre_mass_momentum_term", False))
+    sw = getattr(result, "momentum_term_from", None)
+    if sw is not None:
+        why = (f"switched on by the driver at step {sw['step']} (t = {sw['t_s']:.4g} s, punch "
+               f"{1e3 * sw['punch_displacement_m']:.3g} mm): the next chunk failed without it ({sw['cause']})")
+    elif getattr(result.model, "fibre_mass", None) is None:
+        why = "no fibre mass"
+    else:
+        why = "given" if given else "off (no chunk failed without it)"
+    return {"fibre_mass_momentum_term": bool(given or sw is not None), "fibre_mass_momentum_term_choice": why,
+            "fibre_mass_momentum_term_from_step": None if sw is None else int(sw["step"])}
+
+
 def summarize(result) -> dict:
     """The summary of a :class:`~jaxform.forming.driver.FormingResult` (SPEC section 6 keys and more; JSON-ready)."""
     import jaxform
@@ -118,7 +133,7 @@ def summarize(result) -> dict:
                      "nodes": int(len(info.x0)), "mass_scaling": float(case.mass_scaling),
                      "fibre_mass_scaling": float(getattr(info, "fibre_mass_factor", case.fibre_mass_scaling or 1.0)),
                      "fibre_mass_choice": "auto" if case.fibre_mass_scaling is None else "given",
-                     "fibre_mass_momentum_term": bool(getattr(case, "fibre_mass_momentum_term", False)),
+                     **_momentum_term(result),
                      # products with the fibre-tension stiffness per step: degree - 1
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,

@@ -90,7 +90,7 @@ def _momentum_term(result) -> dict:
     elif getattr(result.model, "fibre_mass", None) is None:
         why = "no fibre mass"
     else:
-        why = "given" if given else "off (no chunk failed without it)"
+        why = "given" if given else "off"
     return {"fibre_mass_momentum_term": bool(given or sw is not None), "fibre_mass_momentum_term_choice": why,
             "fibre_mass_momentum_term_from_step": None if sw is None else int(sw["step"])}
 

@@ -1,14 +1,18 @@
 """Execute notebooks/05_calibration.ipynb: cantilever round trip (two overhangs, one fit) from the
 reference elastica and a picture-frame fit checked on the shell (STYLE habit 9).
 
-Part of the default suite: about 31 s alone on a quiet 2-core machine (one compile of the 20-element
-cantilever, which dominates; the picture frame about 10 s).
+Marked slow: about 31 s alone on a quiet 2-core machine (one compile of the 20-element cantilever,
+which dominates; the picture frame about 10 s), but 38-92 s inside the default run, which was over
+its 12 minute budget (fresh clones of the same tree: 10 min 40 s to 13 min 9 s). The fit's physics
+is tested in test_calibration_cantilever.py and test_fit_shear.py; ``pytest -m slow`` runs this.
 """
 import re
 
+import pytest
 from notebook_runner import run_notebook
 
 
+@pytest.mark.slow
 def test_notebook_05_runs(tmp_path, monkeypatch):
     monkeypatch.setenv("JAXFORM_NOTEBOOK_QUICK", "1")  # one profile instead of two
     nb = run_notebook("05_calibration.ipynb", tmp_path, timeout=300)

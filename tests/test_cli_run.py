@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from jaxform.cli import main
-from helpers import FAST_SET
+from helpers import FAST as FAST_OVERRIDES, FAST_SET
 
 # the presets' former 500 mm/s, not the automatic quasi-static speed: these tests check the outputs
 FAST = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", *FAST_SET, "--quiet"]
@@ -153,10 +153,11 @@ def test_failed_run_keeps_its_frames_and_says_why(tmp_out):
     from jaxform.cli.run import execute
 
     case = cases.apply_overrides(cases.with_element_size(cases.load("case-a-woven-nlbm"), 25e-3),
-                                 ["process.stroke_mm=4", "process.frames=3", "contact.penalty_stiffness_Pa_per_m=1e11",
-                                  "numerics.fibre_mass_scaling=1"])
+                                 ["process.stroke_mm=4", "process.frames=3", *FAST_OVERRIDES,
+                                  "contact.penalty_stiffness_Pa_per_m=1e11"])
     # a time step far above the stable limit (shell and contact) blows up in the first interval (no
-    # fibre mass: with one the driver would first compile and run the failing chunk with its momentum term)
+    # fibre mass: with one the driver would first compile and run the failing chunk with its
+    # momentum term; the test's other numerics share the compiled program of the runs above)
     with pytest.warns(RuntimeWarning, match="stable"):
         result, written = execute(case, tmp_out, quiet=True, dt=2e-5)
     assert not result.complete and result.reason.startswith("simulation failed")
@@ -176,7 +177,7 @@ def test_run_from_a_case_file(tmp_path, capsys):
     path = write_case(case, tmp_path / "my.toml")
     out = tmp_path / "out"
     assert main(["run", str(path), "--out", str(out), "--set", "process.stroke_mm=4", "--set", "process.frames=2",
-                 "--quiet"]) == 0
+                 *FAST_SET, "--quiet"]) == 0
     s = json.loads((out / "summary.json").read_text())
     assert s["case"] == "my-run" and s["complete"] is True
 
@@ -209,7 +210,8 @@ def test_a_run_that_leaves_its_physical_bounds_stops_and_says_why(tmp_out):
     from jaxform.io.frames import FrameWriter
     from jaxform.io.output import prepare_output_dir
 
-    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["process.stroke_mm=4", "process.frames=3"])
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3,
+                         overrides=["process.stroke_mm=4", "process.frames=3", *FAST_OVERRIDES])
     model, state, info = forming.build(case)
     # the punch moves the centre at the punch speed: a bound below it is crossed in the first chunk
     tight = dataclasses.replace(info.bounds, speed=0.5 * case.process.speed)
@@ -263,7 +265,8 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
     from jaxform.cli.run import QUASI_STATIC_KE_IE, execute, report
     from jaxform.plots import forming as fplots
 
-    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["process.stroke_mm=4", "process.frames=3"])
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3,
+                         overrides=["process.stroke_mm=4", "process.frames=3", *FAST_OVERRIDES])
     result, written = execute(case, tmp_out, quiet=True)
     text = io.StringIO()
     report(result, written, tmp_out, stream=text)

@@ -49,6 +49,22 @@ def tmp_out(tmp_path):
     return out
 
 
+# The longest files first: the two workers take files in collection order (``--dist loadfile
+# --no-loadscope-reorder``; xdist's default order, most tests first, put the one-test notebook and
+# README files last, and the README block ran alone for 40 s after the other worker had finished).
+# Longest first, the short files fill the tail.
+LONG_FIRST = ("test_notebook_", "test_readme.py", "test_fibre_mass.py", "test_integrate.py", "test_self_contact.py",
+              "test_forming.py", "test_cantilever.py", "test_metrics_distance.py", "test_cli_wrinkles.py")
+
+
+def pytest_collection_modifyitems(items):
+    def rank(item):
+        name = item.path.name
+        return next((i for i, p in enumerate(LONG_FIRST) if name.startswith(p)), len(LONG_FIRST))
+
+    items.sort(key=rank)  # stable: each file keeps its own order
+
+
 def pytest_sessionfinish(session):
     """The controller removes the run's compilation cache (workers leave it to the controller)."""
     if hasattr(session.config, "workerinput"):

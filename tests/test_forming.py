@@ -161,16 +161,22 @@ def _numerics(name, size_mm, *keys):
 
 def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_stable():
     """contact.safety = 'auto': where the shell's step allows a stiff enough contact it is kept
-    (4 mm, no fibre mass: safety 0.1 as before); with fibre mass 12 at 2 mm and the clamped
+    and the contact takes the room left in the step budget (4 mm, no fibre mass: safety 0.2475,
+    the budget at 0.9 with four contacts on a node); with fibre mass 12 at 2 mm and the clamped
     holder's 1e5 Pa the contact sets the step, at the budget (omega dt / 2 = 0.9 with four contacts
     on a node) and with the stiffness that keeps 1e5 Pa below 10% of the ply; the former advice
     (safety 0.5) broke that budget. Unclamped (Case A, automatic: 1e4 Pa) the same rule gives a
     ten times softer contact and, at 8 mm, a 2.5 times longer step."""
-    from jaxform.forming import numerics
+    from jaxform.forming import numerics, rig
 
-    _, stable, n = _numerics("case-a-woven-nlbm", 4.0, "numerics.fibre_mass_scaling=1")
-    assert (n.governed_by, n.safety, n.dt_max) == ("shell", 0.1, pytest.approx(0.75 * stable))
-    assert n.budget < 0.9
+    case4, stable, n = _numerics("case-a-woven-nlbm", 4.0, "numerics.fibre_mass_scaling=1")
+    assert (n.governed_by, n.dt_max) == ("shell", pytest.approx(0.75 * stable))
+    assert n.safety == pytest.approx(((2 * 0.9) ** 2 - (2 * 0.75) ** 2) / 4)  # 0.2475
+    assert n.budget == pytest.approx(numerics.STEP_BUDGET)
+    # a step closer to the shell's limit leaves less room: the least safety, over the budget
+    fabs = rig.ply_fabrics(case4)
+    tight = numerics.contact_numerics(case4, fabs, stable, None, 0.9)
+    assert tight.safety == numerics.AUTO_SAFETY and tight.budget > numerics.STEP_BUDGET
     case, stable, n = _numerics("case-a-woven-nlbm", 2.0, "numerics.fibre_mass_scaling=12",
                                 "contact.expected_pressure_Pa=1e5")
     assert n.governed_by == "contact" and n.dt_max < 0.75 * stable

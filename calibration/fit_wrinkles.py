@@ -17,7 +17,9 @@ run``. With ``--profile``, cantilever side profiles of the same fabric (``x_mm,z
 at high curvature.
 
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm``, ``shear_scale``, their
-``sigma_*`` (Gauss-Newton / Laplace), ``determined`` (sd under 10 %), ``loss_initial``,
+``sigma_*`` (Gauss-Newton / Laplace, checked against the loss two sds either side of the fit and
+widened where it rises less: ``sigma_check``; ``null`` where no finite sd exists), ``determined``
+(sd under 10 %), ``loss_initial``,
 ``loss_final``, ``rms_mm_per_section`` and ``nrmse_per_section`` (the paper's metric),
 ``gradient_check`` (AD vs central differences at the start and what the fit did about it),
 ``iterations``, ``forming_runs``, ``wall_time_s``, ``converged`` and ``reason``. An existing --out

@@ -171,3 +171,47 @@ def test_fit_wrinkles_script_refuses_before_running(tmp_path, capsys):
 
 
 
+
+
+def test_checked_covariance_keeps_a_quadratic_loss_and_widens_a_jacobian_steeper_than_the_loss():
+    """jaxform.calibrate.uncertainty: on a linear least-squares problem the probes measure exactly
+    the quadratic model's rise (nothing widened); a Jacobian 10x steeper than the loss (what a rough
+    finite difference gives) had sds 10x too small: the check widens them back to the loss's own
+    Laplace figure; a law below the fit within the probes is reported."""
+    from jaxform.calibrate.uncertainty import checked_covariance
+
+    rng = np.random.default_rng(0)
+    A = rng.normal(size=(40, 3)) * np.array([1.0, 5.0, 0.2])
+    b = rng.normal(size=40)
+    q = np.linalg.lstsq(A, b, rcond=None)[0]
+
+    def rows(x):
+        return A @ x - b
+
+    r, lo, hi = rows(q), np.full(3, -50.0), np.full(3, 50.0)
+    cov = np.linalg.inv(A.T @ A)
+    out, rep = checked_covariance(rows, q, r, A, cov, lo, hi, names=("a", "b", "c"))
+    np.testing.assert_allclose(rep["ratio"], 1.0, rtol=1e-9)
+    np.testing.assert_allclose(out, cov, rtol=1e-12)
+    assert rep["lower"] is None
+    steep = 10.0 * A
+    out, rep = checked_covariance(rows, q, r, steep, np.linalg.inv(steep.T @ steep), lo, hi, names=("a", "b", "c"))
+    np.testing.assert_allclose(rep["widened_by"], 10.0, rtol=1e-9)
+    np.testing.assert_allclose(np.diag(out), np.diag(cov), rtol=1e-9)
+    # a probe beyond a bound moves onto it; a failed model run at a probe counts as a steep loss
+    hi2 = q + np.array([1e-3, 50.0, 50.0])
+    failing = {"n": 0}
+
+    def rows_fail(x):
+        failing["n"] += 1
+        return np.full(40, np.nan) if x[2] > q[2] else rows(x)
+
+    seen = []
+    out, rep = checked_covariance(rows_fail, q, r, A, cov, lo, hi2, names=("a", "b", "c"), prefetch=seen.extend)
+    assert rep["steps"][0][1] == pytest.approx(1e-3) and rep["measured_rise"][2][1] is None
+    assert len(seen) == failing["n"] == 6 and rep["ratio"][2] == pytest.approx(1.0)
+    # a lower loss within the probes: the fit is not at a minimum
+    out, rep = checked_covariance(lambda x: np.array([x[0] ** 2 - 1.0]), np.zeros(1), np.array([-1.0]),
+                                  np.ones((1, 1)), np.array([[0.25]]), [-5.0], [5.0], names=("a",))
+    assert rep["lower"]["parameter"] == "a" and rep["lower"]["chi_square"] == pytest.approx(0.0)
+    assert rep["widened_by"][0] == pytest.approx(1e6)  # the loss fell: no finite curvature

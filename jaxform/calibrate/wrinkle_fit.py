@@ -32,7 +32,9 @@ out-of-plane field of amplitude ``imperfection``, tapered to 0 near the tools), 
 Uncertainty (Laplace / Gauss-Newton): ``cov(q) = c (J^T J)^-1`` with ``J`` the Jacobian used,
 ``c`` the reduced chi-square (at least 1) times the ratio of section rows to independent section
 residuals (smoothing correlates neighbouring rows), mapped to ``(b_inf, m0, kappa0, b_init)`` by the
-delta method. A parameter is *determined* where its standard deviation is under
+delta method, then checked against the loss at two sds either side along each parameter and
+widened where the loss rises less than that model says (:mod:`jaxform.calibrate.uncertainty`,
+2 p more runs). A parameter is *determined* where its standard deviation is under
 :data:`DETERMINED_SD` of its value. SI units throughout.
 """
 from __future__ import annotations
@@ -57,6 +59,7 @@ from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
 from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
+from jaxform.calibrate.uncertainty import checked_covariance
 from jaxform.forming.fields import state_fields
 from jaxform.metrics import section_nrmse
 from jaxform.shell import fibre_curvatures
@@ -103,10 +106,11 @@ class WrinkleFit:
     starts: list  # (q, loss) of the global phase
     fitted: list  # (m,) simulated amplitude per section at the fitted law, m
     initial: list  # the same at the starting law
-    covariance: np.ndarray
+    covariance: np.ndarray  # of q, checked (sigma_check)
+    sigma_check: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.checked_covariance
 
     def as_dict(self) -> dict:
-        v, s = self.values, self.sigma
+        v, s = self.values, {k: (x if math.isfinite(x) else None) for k, x in self.sigma.items()}
         out = {"b_inf_Nm": v["b_inf"], "m0_N": v["m0"], "kappa0_per_m": v["kappa0"], "b_init_Nm": v["b_init"],
                "shear_scale": self.shear_scale,
                "sigma_b_inf_Nm": s["b_inf"], "sigma_m0_N": s["m0"], "sigma_kappa0_per_m": s["kappa0"],
@@ -117,7 +121,8 @@ class WrinkleFit:
                "nrmse_per_section": self.nrmse_per_section, "kappa_reach_per_m": self.kappa_reach,
                "gradient_check": self.gradient_check, "jacobian": self.jacobian, "iterations": self.iterations,
                "forming_runs": self.forming_runs, "wall_time_s": self.wall_time, "converged": self.converged,
-               "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts]}
+               "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts],
+               "sigma_check": self.sigma_check}
         if self.profile_rmse is not None:
             out["profile_rmse_mm"] = 1e3 * self.profile_rmse
         return out
@@ -442,7 +447,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     r = rows(q)
     J = fd_jac(q)
     return _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi,
-                      starts, q0, time.perf_counter() - t0)
+                      starts, q0, time.perf_counter() - t0, rows)
 
 
 def _n_prof(prof) -> int:
@@ -450,7 +455,7 @@ def _n_prof(prof) -> int:
 
 
 def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi, starts, q0,
-               wall) -> WrinkleFit:
+               wall, rows) -> WrinkleFit:
     p = len(q)
     y, valid, ok, reach = runs.evaluate([q])[0]
     y0 = runs.evaluate([q0])[0][0]
@@ -459,7 +464,8 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     n_eff = n_ind + _n_prof(prof)
     chi2 = float(r @ r)
     c = max(1.0, chi2 / max(n_eff - p, 1)) * (n_sec + _n_prof(prof)) / n_eff
-    cov = c * np.linalg.pinv(J.T @ J)
+    cov, sigma_check = checked_covariance(rows, q, r, J, c * np.linalg.pinv(J.T @ J), lo, hi, names=NAMES[:p],
+                                          prefetch=runs.evaluate)
     dtype = jnp.result_type(float)
     phys = np.asarray(_physical(jnp.asarray(q[:3], dtype), "voce"), float)
     T = np.asarray(jax.jacfwd(lambda v: _physical(v, "voce"))(jnp.asarray(q[:3], dtype)), float)
@@ -492,6 +498,9 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     at = [NAMES[i] for i in range(p) if q[i] <= lo[i] + 1e-6 or (q[i] >= hi[i] - 1e-6 and i != 1)]
     if at:
         reasons.append(f"{', '.join(at)} at the search bound")
+    if sigma_check["lower"] is not None:
+        reasons.append(f"a law {sigma_check['probe_sds']:g} sds from the fit along {sigma_check['lower']['parameter']} "
+                       f"fits better (chi-square {sigma_check['lower']['chi_square']:.4g} against {chi2:.4g})")
     chi_rms = math.sqrt(chi2 / max(len(r), 1))
     if not chi_rms <= CHI_LIMIT:
         reasons.append(f"the fitted sections miss the data by {chi_rms:.3g} noise sds RMS (smoothed rows; limit "
@@ -503,7 +512,8 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
                                                if prof is not None else None),
         kappa_reach=reach, gradient_check=check, jacobian=mode, iterations=int(opt.get("njev") or opt.get("nit") or 0), forming_runs=runs.runs,
         wall_time=wall, converged=converged and not reasons, reason="; ".join(reasons),
-        starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov)
+        starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov,
+        sigma_check=sigma_check)
 
 
 __all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "predict_sections", "sections_of", "section_loss", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",

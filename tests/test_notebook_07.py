@@ -1,7 +1,9 @@
 """Execute notebooks/07_fit_wrinkles.ipynb in quick mode: the wrinkle-section fit end to end
 (synthetic sections from a hidden law at 16 mm, ``fit_wrinkles`` with two starts and three
-evaluations, the held-out prediction, the figure). Marked ``slow`` (about 100 s alone on one core:
-one compile of the forming program, about 15 runs of 5 s, one compile for the held-out section):
+evaluations at the former 500 mm/s, the sigma check's six probes, the held-out prediction, the
+figure). Marked ``slow`` (about 100 s alone on one core before the probes: one compile of the
+forming program, about 15 runs of 5 s, one compile for the held-out section; at the automatic
+62.5 mm/s it took 618 s beside a forming run):
 with it the default suite took 15 min on a fresh clone of the 2-core machine, over its 12 min
 budget; ``pytest -m slow tests/test_notebook_07.py`` runs it.
 

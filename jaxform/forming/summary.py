@@ -172,8 +172,12 @@ def quasi_static_check(result, half) -> dict:
     Returns a JSON-ready dict: the two speeds (mm/s), ``shear_p95_deg`` (95th percentile over the
     nodes of the final shear-angle difference), ``draw_in_edge_mid_rel`` (relative difference of
     the edge mid-side draw-in), ``flange_wrinkles`` (the two counts) and ``flange_wrinkles_diff``,
-    the ``limits`` (:data:`QUASI_STATIC_LIMITS`) and ``quasi_static`` (all within them). A check
-    that cannot be made (a run incomplete, or no frame) says why in ``reason`` and is not passed.
+    the ``limits`` (:data:`QUASI_STATIC_LIMITS`) and ``quasi_static`` (all within them); and
+    along the stroke, ``shear_p95_deg_per_frame`` at ``punch_mm_per_frame`` and
+    ``shear_agrees_to_punch_mm``, the deepest frame up to which every frame's maps agree within the
+    limit (where a run leaves quasi-static: NCF Case A at 4 mm agrees to 35 mm of its 50, then its
+    softening shear law snaps). A check that cannot be made (a run incomplete, or no frame) says
+    why in ``reason`` and is not passed.
     """
     out = {"speed_mm_per_s": 1e3 * float(result.info.case.process.speed),
            "half_speed_mm_per_s": 1e3 * float(half.info.case.process.speed),
@@ -185,7 +189,13 @@ def quasi_static_check(result, half) -> dict:
     if len(result.info.x0) != len(half.info.x0):
         raise ValueError(f"quasi_static_check: the runs have {len(result.info.x0)} and {len(half.info.x0)} nodes: "
                          "they must share a mesh")
-    g = np.degrees(np.abs(np.asarray(result.fields["shear_angle"][-1]) - np.asarray(half.fields["shear_angle"][-1])))
+    sa, sb = (np.asarray(r.fields["shear_angle"]) for r in (result, half))
+    per = [float(np.percentile(np.degrees(np.abs(a - b)), 95)) for a, b in zip(sa, sb)]
+    depth = 1e3 * np.abs(np.interp(result.t[:len(per)], result.history["t_s"], result.history["punch_displacement_m"]))
+    ok = np.cumprod(np.asarray(per) < QUASI_STATIC_LIMITS["shear_p95_deg"]).astype(bool)
+    out.update(shear_p95_deg_per_frame=per, punch_mm_per_frame=depth.tolist(),
+               shear_agrees_to_punch_mm=float(depth[ok].max()) if ok.any() else None)
+    g = np.degrees(np.abs(sa[-1] - sb[-1]))
     d0, d1 = (float(r.summary["draw_in"]["edge_mid_m"]) for r in (result, half))
     w0, w1 = (r.summary["flange_wrinkles"] for r in (result, half))
     out.update(shear_p95_deg=float(np.percentile(g, 95)), draw_in_edge_mid_rel=abs(d0 - d1) / max(abs(d1), 1e-30),

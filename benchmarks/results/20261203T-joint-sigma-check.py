@@ -29,4 +29,4 @@ d = fit.as_dict()
 out = {"wall_s": time.perf_counter() - t0, "truth": _bw.TRUTH, "old_fit": {k: f[k] for k in f if k.startswith(("b_", "m0", "kappa0", "sigma"))},
        "new": {k: d[k] for k in d if k.startswith(("b_", "m0", "kappa0", "sigma", "determined", "converged", "reason", "loss", "forming"))}}
 print(json.dumps(out, indent=1))
-json.dump(out, open("/tmp/s21/joint/check.json", "w"), indent=1)
+json.dump(out, open(pathlib.Path(__file__).with_suffix(".json"), "w"), indent=1)

@@ -177,9 +177,9 @@ def _report_check(check, stream):
           f"{check['flange_wrinkles'][1]}: {verdict}", file=stream)
     to, per, depth = check.get("shear_agrees_to_punch_mm"), check.get("shear_p95_deg_per_frame"), check.get("punch_mm_per_frame")
     if per and max(per) >= lim["shear_p95_deg"]:
-        first = next(i for i, v in enumerate(per) if v >= lim["shear_p95_deg"])
-        print(f"  along the stroke: the shear maps agree within {lim['shear_p95_deg']:g}° up to "
-              f"{0.0 if to is None else to:.1f} mm of punch travel; {per[first]:.2f}° at {depth[first]:.1f} mm", file=stream)
+        over = ", ".join(f"{v:.2f}° at {d:.1f} mm" for v, d in zip(per, depth) if v >= lim["shear_p95_deg"])
+        print(f"  along the stroke: the shear maps part for good after {0.0 if to is None else to:.1f} mm of punch "
+              f"travel; beyond {lim['shear_p95_deg']:g}°: {over}", file=stream)
 
 
 def report(result, written, out, stream=None):

@@ -170,9 +170,6 @@ def test_fit_wrinkles_script_refuses_before_running(tmp_path, capsys):
     assert rc == 2 and "--areal-mass-gsm" in err
 
 
-
-
-
 def test_checked_covariance_keeps_a_quadratic_loss_and_widens_a_jacobian_steeper_than_the_loss():
     """jaxform.calibrate.uncertainty: on a linear least-squares problem the probes measure exactly
     the quadratic model's rise (nothing widened); a Jacobian 10x steeper than the loss (what a rough

@@ -194,14 +194,12 @@ def quasi_static_check(result, half) -> dict:
     sa, sb = (np.asarray(r.fields["shear_angle"]) for r in (result, half))
     per = [float(np.percentile(np.degrees(np.abs(a - b)), 95)) for a, b in zip(sa, sb)]
     depth = 1e3 * np.abs(np.interp(result.t[:len(per)], result.history["t_s"], result.history["punch_displacement_m"]))
-    bad = np.asarray(per) >= QUASI_STATIC_LIMITS["shear_p95_deg"]
-    last_ok = len(bad) - 1 - (int(np.argmin(bad[::-1])) if not bad.all() else len(bad))  # before the trailing failures
+    agree = np.flatnonzero(np.asarray(per) < QUASI_STATIC_LIMITS["shear_p95_deg"])  # the last one precedes the trailing failures
     out.update(shear_p95_deg_per_frame=per, punch_mm_per_frame=depth.tolist(),
-               shear_agrees_to_punch_mm=float(depth[last_ok]) if last_ok >= 0 else None)
-    g = np.degrees(np.abs(sa[-1] - sb[-1]))
+               shear_agrees_to_punch_mm=float(depth[agree[-1]]) if agree.size else None)
     d0, d1 = (float(r.summary["draw_in"]["edge_mid_m"]) for r in (result, half))
     w0, w1 = (r.summary["flange_wrinkles"] for r in (result, half))
-    out.update(shear_p95_deg=float(np.percentile(g, 95)), draw_in_edge_mid_rel=abs(d0 - d1) / max(abs(d1), 1e-30),
+    out.update(shear_p95_deg=per[-1], draw_in_edge_mid_rel=abs(d0 - d1) / max(abs(d1), 1e-30),
                draw_in_edge_mid_m=[d0, d1], flange_wrinkles=[w0, w1],
                flange_wrinkles_diff=None if w0 is None or w1 is None else abs(int(w0) - int(w1)))
     lim = QUASI_STATIC_LIMITS

@@ -308,7 +308,8 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     """A forming run whose blank spins in-plane and stretches (NCF, 25 mm, fibre mass 12 without
     its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792) is
     run again from its start with it, the run completes, and the summary says from which step and
-    why. The same rig at rest never pays for the term."""
+    why. The same rig at rest never pays for the term. Batched together, each member gets what its
+    own run gave."""
     import dataclasses
 
     from jaxform import cases, forming
@@ -336,3 +337,15 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     calm = forming.run(forming.Rig(model, state, info), catch=True)
     assert calm.complete and calm.momentum_term_from is None and not calm.model.fibre_mass.geometric
     assert calm.summary["numerics"]["fibre_mass_momentum_term_choice"].startswith("off")
+    # a batch of the two (one program) gives each member what its own run gave: the spun one goes
+    # on alone with the term from the same step, the calm one never switches
+    from jaxform.forming import batch
+
+    spun_b, calm_b = batch.run_part([forming.Rig(model, spun, info), forming.Rig(model, state, info)])
+    assert spun_b.complete and calm_b.complete, (spun_b.reason, calm_b.reason)
+    assert spun_b.momentum_term_from["step"] == sw["step"] and spun_b.model.fibre_mass.geometric
+    assert spun_b.summary["numerics"]["fibre_mass_momentum_term_from_step"] == sw["step"]
+    assert calm_b.momentum_term_from is None and not calm_b.model.fibre_mass.geometric
+    assert len(spun_b.t) == len(res.t) and np.array_equal(spun_b.history["step"], res.history["step"])
+    # positions are not compared: the members share their contact searches' refreshes
+    # (jaxform.batching), so a batch is not bit-identical to single runs, and the spun blank is chaotic

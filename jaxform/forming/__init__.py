@@ -15,7 +15,7 @@ Modules, along the data flow (imports point one way):
 from __future__ import annotations
 
 from jaxform.forming.case import Case, ply_heights
-from jaxform.forming.driver import ENERGY_FLOOR, FormingResult, rollout, run, run_steps, simulate
+from jaxform.forming.driver import ENERGY_FLOOR, FormingResult, rollout, run, run_steps, simulate, with_momentum_term
 from jaxform.forming.fields import node_average, state_fields
 from jaxform.forming.rig import (Rig, RunInfo, build, build_fabric, build_mesh, build_tools, grid_quads, ply_fabrics,
                                  punch_motion, stroke_time, with_fabric)
@@ -24,5 +24,5 @@ from jaxform.forming.summary import (QUASI_STATIC_LIMITS, draw_in, flange_census
 
 __all__ = ["Case", "ply_heights", "Rig", "RunInfo", "build", "build_fabric", "build_mesh", "build_tools", "grid_quads",
            "ply_fabrics", "punch_motion", "stroke_time", "with_fabric", "node_average", "state_fields", "ENERGY_FLOOR",
-           "FormingResult", "rollout", "run", "run_steps", "simulate", "draw_in", "flange_census", "flange_mask",
+           "FormingResult", "rollout", "run", "run_steps", "simulate", "with_momentum_term", "draw_in", "flange_census", "flange_mask",
            "summarize", "symmetry_error", "QUASI_STATIC_LIMITS", "quasi_static_check"]

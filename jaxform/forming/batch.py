@@ -26,7 +26,9 @@ How members share a program:
 * **Failures.** The host checks every member after each stretch, as the single-run driver does
   (energy balance, non-finite values, physical bounds). A failed member keeps its frames up to its
   last good one and its reason, and is parked (its initial state, zero steps) while the others go
-  on.
+  on. A member with a fibre mass but not its momentum term then goes on alone from its last good
+  state with the term on, after the batch, as its own run would
+  (:func:`jaxform.forming.driver.run`; ``momentum_term_from`` of its result).
 * **Memory.** A group whose program would not fit in the memory the devices have is split into
   parts that do, run one after the other; ``summary["batch"]`` says so (:func:`plan_parts`).
 
@@ -53,8 +55,8 @@ from jax.sharding import PartitionSpec as P
 from jaxform import integrate
 from jaxform.batching import BATCH_AXIS
 from jaxform.forming.case import Case, to_dict
-from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, _floor, out_of_bounds_message,
-                                    physical_causes)
+from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive,
+                                    out_of_bounds_message, physical_causes)
 from jaxform.forming.fields import SCALARS, state_fields
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, build
@@ -319,7 +321,10 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
             for i in range(B)]
     active = np.array([True] * B + [False] * (Bp - B))
     reasons: list = [None] * B
+    causes: list = [None] * B  # why a member failed, as the single-run driver words it
     last_good = [None] * B  # host copies of a failed member's last good state (its final state)
+    finished: set = set()
+    alone: dict = {}  # members that switched their fibre mass's momentum term on: their Standing, run alone
     n_sub = info0.sub_steps
 
     def view(host_state, fl, i):
@@ -364,15 +369,17 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                         m_i = _member(new, all_axes, i)
                         reasons[i] = ("simulation failed: " + integrate.describe_failure(m_i, _member(model, axes, i))
                                       + " The frames up to the last good one are kept.")
+                        causes[i] = integrate.failure_cause(m_i)
                         failed.append(int(i))
                         continue
                     if hx is None:
                         hx, hs = np.asarray(new.x), (np.asarray(new.step), np.asarray(new.t))
                         hfl = {key: np.asarray(fl[key]) for key in SCALARS}
-                    causes = physical_causes(hx[i], {key: v[i] for key, v in hfl.items()}, infos[i].bounds)
-                    if causes:
+                    out = physical_causes(hx[i], {key: v[i] for key, v in hfl.items()}, infos[i].bounds)
+                    if out:
                         reasons[i] = "simulation failed: " + out_of_bounds_message(
-                            int(hs[0][i]), float(hs[1][i]), float(hfl["punch_displacement"][i]), causes)
+                            int(hs[0][i]), float(hs[1][i]), float(hfl["punch_displacement"][i]), out)
+                        causes[i] = "; ".join(out)
                         failed.append(int(i))
                 if failed:
                     new = park(new, failed)
@@ -384,10 +391,25 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                                 float(np.asarray(fl["punch_displacement"])[i]), time.perf_counter() - t_wall)
             if not active[:B].any():
                 break
+        for i in range(B):  # as its own run would: a fast fibre mass that failed goes on with its exact term
+            at = Standing(_member(model, axes, i), last_good[i])
+            if last_good[i] is None or not at.switch(recs[i], causes[i]):
+                continue
+            alone[i] = at
+            try:
+                drive(at, infos[i], recs[i], e0=rigs[i].state.energies, x_ref=rigs[i].state.x, on_progress=on_progress,
+                      t_wall=t_wall)
+                reasons[i] = None
+            except integrate.SimulationError as err:
+                reasons[i] = f"simulation failed: {err}"
+            last_good[i] = at.state
+            finished.add(i)
     except KeyboardInterrupt as err:
         for i in np.flatnonzero(active[:B]):
             reasons[i] = INTERRUPTED + (f": {err}" if str(err) else "")
             last_good[i] = _member(state, all_axes, i)
+        for i in set(alone) - finished:
+            reasons[i], last_good[i] = INTERRUPTED + (f": {err}" if str(err) else ""), alone[i].state
     wall = time.perf_counter() - t_wall
     results = []
     for i in range(B):
@@ -397,7 +419,8 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
             t=np.asarray(rec.t), x=np.asarray(rec.x), fields={k: np.asarray(v) for k, v in rec.fields.items()},
             history={k: np.asarray(v) for k, v in rec.hist.items()}, faces=infos[i].faces, ply_id=infos[i].ply_id,
             info=infos[i], complete=reasons[i] is None, reason=reasons[i], wall_time_s=wall, summary={},
-            final_state=final, model=_member(model, axes, i))
+            final_state=final, model=alone[i].model if i in alone else _member(model, axes, i),
+            momentum_term_from=alone[i].switched if i in alone else None)
         res.summary = summarize(res)
         res.summary["batch"] = {"members": B, "devices": D, "padded_to": Bp, "why": label,
                                 "wall_time_is": "the program's, shared by its members"}

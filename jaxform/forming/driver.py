@@ -203,13 +203,62 @@ def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo):
     return new, fl
 
 
-def _with_momentum_term(model):
+def with_momentum_term(model):
     """``model`` with its fibre mass's momentum term on (:func:`jaxform.fibre_mass.geometric_force`),
     or ``None`` where it has no fibre mass or has the term already."""
     fm = model.fibre_mass
     if fm is None or fm.geometric:
         return None
     return dataclasses.replace(model, fibre_mass=dataclasses.replace(fm, geometric=True))
+
+
+@dataclasses.dataclass
+class Standing:
+    """Where a host run stands: the model running, the last good state, and where the driver
+    switched the fibre mass's momentum term on (``FormingResult.momentum_term_from``). Kept
+    current by :func:`drive`, so that a run that raises still has its last good state."""
+
+    model: Any
+    state: Any
+    switched: dict | None = None
+
+    def switch(self, rec: "Recorder", cause: str) -> bool:
+        """Switch the momentum term on from the last good state because a chunk failed with
+        ``cause``; False (nothing changed) where the model has no fast fibre mass to switch."""
+        exact = with_momentum_term(self.model)
+        if exact is None:
+            return False
+        self.model = exact
+        self.switched = {"step": int(self.state.step), "t_s": float(self.state.t),
+                         "punch_displacement_m": float(rec.hist["punch_displacement_m"][-1]), "cause": cause}
+        return True
+
+
+def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progress: Callable | None = None,
+          t_wall: float | None = None) -> None:
+    """Run the chunks of ``info`` still to do from ``at.state`` (its step says how many are done),
+    sampling and writing frames into ``rec``. A chunk that fails with a fibre mass but not its
+    momentum term is run again from its start with the term, and so is the rest (:func:`run`).
+    Raises :class:`~jaxform.integrate.SimulationError` on a failure it cannot switch away; ``at``
+    then holds the last good state."""
+    t_wall = time.perf_counter() if t_wall is None else t_wall
+    ply_arr = jnp.asarray(info.ply_id)
+    floor = jnp.asarray(_floor(at.state), at.state.x.dtype)
+    n_sub = jnp.asarray(info.sub_steps, jnp.int32)
+    for c in range(int(at.state.step) // info.sub_steps, (info.n_frames - 1) * info.samples_per_frame):
+        try:
+            new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info)
+        except integrate.SimulationError as err:
+            if not at.switch(rec, err.cause):
+                raise
+            new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info)
+        at.state = new
+        rec.sample(new, fl)
+        if on_progress is not None:
+            on_progress(int(new.step), info.n_steps, float(new.t), float(fl["punch_displacement"]),
+                        time.perf_counter() - t_wall)
+        if (c + 1) % info.samples_per_frame == 0:
+            rec.frame(new, fl)
 
 
 def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False,
@@ -238,38 +287,15 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     """
     t_wall = time.perf_counter()
     model, state, info = rig
-    ply_arr = jnp.asarray(info.ply_id)
-    n_plies = info.case.n_plies
-    e0, x_ref = state.energies, state.x
-    floor = jnp.asarray(_floor(state), state.x.dtype)
-    n_sub = jnp.asarray(info.sub_steps, jnp.int32)
+    at = Standing(model, state)
     rec = Recorder(on_frame)
-    complete, reason, switched = False, None, None
+    complete, reason = False, None
     try:
-        fl = fields_jit(model, state, ply_arr, n_plies=n_plies)
+        fl = fields_jit(model, state, jnp.asarray(info.ply_id), n_plies=info.case.n_plies)
         rec.sample(state, fl)
         rec.frame(state, fl)
         if not build_only:
-            for _ in range(info.n_frames - 1):
-                for _ in range(info.samples_per_frame):
-                    try:
-                        new, fl = _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info)
-                    except integrate.SimulationError as err:
-                        exact = _with_momentum_term(model)
-                        if exact is None:
-                            raise
-                        # the fast fibre mass failed: this chunk again, and the rest, with its exact term
-                        model = exact
-                        switched = {"step": int(state.step), "t_s": float(state.t),
-                                    "punch_displacement_m": float(rec.hist["punch_displacement_m"][-1]),
-                                    "cause": err.cause}
-                        new, fl = _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info)
-                    state = new
-                    rec.sample(state, fl)
-                    if on_progress is not None:
-                        on_progress(int(state.step), info.n_steps, float(state.t), float(fl["punch_displacement"]),
-                                    time.perf_counter() - t_wall)
-                rec.frame(state, fl)
+            drive(at, info, rec, e0=state.energies, x_ref=state.x, on_progress=on_progress, t_wall=t_wall)
             complete = True
     except KeyboardInterrupt as err:
         if not catch:
@@ -288,8 +314,8 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     result = FormingResult(
         t=np.asarray(rec.t), x=np.asarray(rec.x), fields={k: np.asarray(v) for k, v in rec.fields.items()},
         history={k: np.asarray(v) for k, v in rec.hist.items()}, faces=info.faces, ply_id=info.ply_id, info=info,
-        complete=complete, reason=reason, wall_time_s=time.perf_counter() - t_wall, summary={}, final_state=state,
-        model=model, momentum_term_from=switched)
+        complete=complete, reason=reason, wall_time_s=time.perf_counter() - t_wall, summary={}, final_state=at.state,
+        model=at.model, momentum_term_from=at.switched)
     result.summary = summarize(result)
     return result
 
@@ -327,5 +353,5 @@ def simulate(case: Case, *, dtype=None, element_size: float | None = None, overr
     return result
 
 
-__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "run", "simulate", "physical_causes",
+__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "Standing", "drive", "with_momentum_term", "run", "simulate", "physical_causes",
            "out_of_bounds_message"]

@@ -12,6 +12,7 @@ from jaxform import cases
 from jaxform.calibrate import sections as S
 from jaxform.calibrate.sections import Section
 from jaxform.contact import ToolLoad
+from jaxform.calibrate import section_runs
 from jaxform.calibrate import wrinkle_fit as wf
 from jaxform.io import calibration_files as cf
 from jaxform.materials import LinearBending, PolynomialShear, VoceBending, preset
@@ -122,7 +123,7 @@ def test_the_fit_s_imperfect_blanks_start_clear_of_the_tools():
     case = cases.resolve("case-a-woven-nlbm", element_size=25e-3)
     sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
                   end=np.array([0.09, 0.0]))
-    runs = wf._Runs(case, [sec], "voce", 3, 0.1 * case.ply_thickness, 1, 1)
+    runs = section_runs.SectionRuns(case, [sec], "voce", 3, 0.1 * case.ply_thickness, 1, 1)
     model, state = runs.rig[0], runs.rig[1]
     assert float(jnp.abs(runs.dz[1:]).max()) > 0
     for k in (1, 2):
@@ -131,6 +132,30 @@ def test_the_fit_s_imperfect_blanks_start_clear_of_the_tools():
             if isinstance(ld, ToolLoad):
                 gap0, gap = np.asarray(ld.gap(state.x, state.t, ls)), np.asarray(ld.gap(x, state.t, ls))
                 assert np.all(gap >= np.minimum(gap0, 0.0) - 1e-12)  # nobody pushed into a tool
+
+
+def test_a_fit_run_that_fails_without_the_momentum_term_is_run_again_with_it(monkeypatch):
+    """As ``forming.run`` switches the fibre mass's momentum term on where a chunk fails without it
+    (tested in test_fibre_mass), the fit runs a law again with the term where its run failed, and
+    keeps the first result of the laws that did not fail. Wiring only: the program is stubbed, the
+    flag of the fibre mass tells which rig it got."""
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
+    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
+                  end=np.array([0.09, 0.0]))
+    runs = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 2, 1)
+    assert not runs.rig[0].fibre_mass.geometric and runs.rigs[1][0].fibre_mass.geometric
+    m = len(sec.s)
+
+    def stub(Q, Z, rig, lines, static):  # law 0 fails without the term; the exact rig's results are 2 and 3
+        exact = rig[0].fibre_mass.geometric
+        y = np.full((len(Q), m), 2.0 if exact else 1.0)
+        ok = np.array([True, True]) if exact else np.asarray(Q)[:, 0] > -5.0
+        return y, np.ones((len(Q), m), bool), ok, np.full(len(Q), 3.0 if exact else 1.0)
+
+    monkeypatch.setattr(section_runs, "_batch", stub)
+    (y0, _, ok0, r0), (y1, _, ok1, r1) = runs.evaluate([np.array([-6.0, -1.0, 3.0]), np.array([-4.0, -1.0, 3.0])])
+    assert ok0 and ok1 and np.all(y0 == 2.0) and r0 == 3.0 and np.all(y1 == 1.0) and r1 == 1.0
+    assert runs.exact == {section_runs._key(np.array([-6.0, -1.0, 3.0]))} and runs.runs == 4
 
 
 def _cli(argv, capsys):

@@ -12,7 +12,9 @@ units of the smoothed noise (:mod:`jaxform.calibrate.sections`: tolerant of smal
 and with profiles the cantilever fit's z-residuals in units of their noise. The forming rig is
 built once; each trial law is one ``forming.rollout`` of the whole stroke, in batches vmapped over
 :data:`jaxform.batching.BATCH_AXIS` (1 wide on a CPU; an anonymous vmap ran both branches of the
-contact's ``lax.cond`` every step: 206 s against 4.9 s per 16 mm run).
+contact's ``lax.cond`` every step: 206 s against 4.9 s per 16 mm run); a run that fails without the
+fibre mass's momentum term is run again with it, as ``forming.run`` would
+(:mod:`jaxform.calibrate.section_runs`).
 
 Why not plain gradients. Reverse mode through the run is exact (it equals central differences at
 ``h = 1e-8``), but the buckled flange is chaotically sensitive to the law: over a whole stroke
@@ -40,7 +42,6 @@ widened where the loss rises less than that model says (:mod:`jaxform.calibrate.
 from __future__ import annotations
 
 import dataclasses
-import functools
 import math
 import time
 from typing import Any, Callable, NamedTuple, Sequence
@@ -51,18 +52,15 @@ import numpy as np
 from scipy.optimize import least_squares, lsq_linear, minimize
 from scipy.stats.qmc import LatinHypercube
 
-from jaxform import cantilever, forming
-from jaxform.contact import ToolLoad
-from jaxform.batching import BATCH_AXIS
+from jaxform import cantilever
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
 from jaxform.calibrate.imperfections import imperfections
+from jaxform.calibrate.section_runs import SectionRuns, predict_sections, sections_of
 from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
 from jaxform.calibrate.uncertainty import checked_covariance
-from jaxform.forming.fields import state_fields
 from jaxform.metrics import section_nrmse
-from jaxform.shell import fibre_curvatures
 
 PARAM_KINDS = ("voce", "voce+shear")
 NOISE = 5e-5  # m, a scanner's noise on the amplitude
@@ -72,8 +70,6 @@ SPAN = 10.0  # B_init and kappa0 are searched within this factor of the starting
 SHEAR_SPAN = 3.0
 DETERMINED_SD = 0.10
 CHI_LIMIT = 3.0  # a fit is usable only where its residual rows' RMS is at most this many noise sds
-GRAD_FRAMES = 21  # the fit's rig has this many frames: one checkpoint each in the reverse pass
-KAPPA_PERCENTILE = 98.0  # "the curvatures the wrinkles reach": this percentile of |kappa| on the fitted part
 NAMES = ("B_init", "B_inf/B_init", "kappa0", "shear scale")
 START_HALF_WIDTH = (math.log(2.0), math.log(3.0), math.log(3.0), math.log(1.5))  # global phase box, log space
 
@@ -95,7 +91,7 @@ class WrinkleFit:
     rms_initial_per_section: list
     nrmse_per_section: list  # fractions (section_nrmse), at the fitted law
     profile_rmse: float | None  # m, the cantilever profiles' z-residual (joint fit)
-    kappa_reach: float  # 1/m, KAPPA_PERCENTILE of |kappa| on the fitted part
+    kappa_reach: float  # 1/m, section_runs.KAPPA_PERCENTILE of |kappa| on the fitted part
     gradient_check: dict
     jacobian: str  # "ad" or "fd"
     iterations: int
@@ -137,136 +133,6 @@ class Progress(NamedTuple):
     q: tuple
 
 
-class _Steps(NamedTuple):
-    """What :func:`jaxform.forming.rollout` reads of a run's info (hashable: a static argument)."""
-
-    n_frames: int
-    every: int
-
-
-def _member(q, dz, rig, lines, static):
-    """One forming run with the law ``q`` from the blank perturbed by ``dz``: ``(y, valid, ok, kappa_reach)``."""
-    kind, n_plies, steps, ns, checkpoint = static
-    model, state, fabric, ply_id, sel, faces = rig
-    q = q.astype(state.x.dtype)
-    law = law_from_q(q[:3], "voce")
-    fab = fabric.replace(bending=(law, law))
-    if kind == "voce+shear":
-        fab = fab.replace(shear=scaled_shear(fab.shear, jnp.exp(q[3])))
-    m = forming.with_fabric(model, fab)
-    st = dataclasses.replace(state, x=state.x + dz, u=state.u + dz.T)
-    s, _ = forming.rollout(m, st, steps, checkpoint=checkpoint)
-    dev = state_fields(m, s, ply_id, n_plies)["deviation"]
-    x, d = s.x[sel], dev[sel]
-    vals, oks = zip(*(sec_mod.simulated(x, faces, d, a, b, sq, n) for (a, b, sq), n in zip(lines, ns)))
-    y = jnp.concatenate(vals)
-    kappa = fibre_curvatures(s.x, m.shell.mesh, m.shell.ref)[sel]
-    reach = jnp.percentile(jnp.abs(kappa), KAPPA_PERCENTILE)
-    return y, jnp.concatenate(oks), (s.bad_step < 0) & jnp.all(jnp.isfinite(y)), reach
-
-
-@functools.partial(jax.jit, static_argnames=("static",))
-def _batch(Q, Z, rig, lines, static):
-    """:func:`_member` over a batch (one compiled program per rig shape, shared by every fit in a process)."""
-    return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static), axis_name=BATCH_AXIS)(Q, Z)
-
-
-@functools.partial(jax.jit, static_argnames=("static",))
-def _grad(q, dz, rig, lines, R, meas, valid, static):
-    """Gradient of ``0.5 |R (y - meas)|^2`` (``y`` masked by ``valid``), checkpointed reverse mode."""
-    def loss(q):
-        r = R @ jnp.where(valid, _member(q, dz, rig, lines, static[:-1] + (True,))[0] - meas, 0.0)
-        return 0.5 * jnp.sum(r * r)
-
-    return jax.grad(loss)(q)
-
-
-class _Runs:
-    """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``."""
-
-    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply):
-        rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)))
-        model, state, info = rig
-        fab = model.shell.fabrics[0]
-        if fab.bending is None:
-            raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
-        if not 1 <= ply <= case.n_plies:
-            raise ValueError(f"fit_wrinkles: ply = {ply}: the case has plies 1..{case.n_plies}")
-        self.law0, self.width, self.seeds = voce_start(fab.bending[0]), int(width), int(seeds)
-        self.dtype = state.x.dtype
-        sel = np.asarray(info.ply_id) == ply
-        local = np.cumsum(sel) - 1
-        faces = local[info.faces[np.all(sel[info.faces], axis=1)]]
-        self.rig = (model, state, fab, jnp.asarray(info.ply_id), jnp.asarray(np.flatnonzero(sel)), jnp.asarray(faces))
-        self.lines = tuple((jnp.asarray(s.start, self.dtype), jnp.asarray(s.end, self.dtype), jnp.asarray(s.s, self.dtype))
-                           for s in sections)
-        ns = tuple(sec_mod.n_samples(s, case.element_size) for s in sections)
-        self.static = (param_kind, case.n_plies, _Steps(info.n_frames, info.every), ns, False)
-        clearance = np.min([np.asarray(ld.gap(state.x, state.t, ls), float) for ld, ls in zip(model.loads, state.loads)
-                            if isinstance(ld, ToolLoad)] or [np.full(len(info.x0), np.inf)], axis=0)
-        self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size, clearance), self.dtype)
-        self.cache: dict = {}
-        self.runs = 0
-
-    def evaluate(self, qs: Sequence[np.ndarray]) -> list:
-        """``(y (M,), valid (M,), ok, kappa_reach)`` per ``q``, the mean over the seeds (host)."""
-        keys = [tuple(np.round(np.asarray(q, float), 12).tolist()) for q in qs]
-        todo = [k for k in dict.fromkeys(keys) if k not in self.cache]
-        members = [(k, i) for k in todo for i in range(self.seeds)]
-        out: dict = {}
-        for a in range(0, len(members), self.width):
-            chunk = members[a:a + self.width]
-            pad = chunk + [chunk[-1]] * (self.width - len(chunk))
-            Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
-            Z = self.dz[np.array([i for _, i in pad])]
-            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
-            self.runs += len(chunk)
-            for j, (k, _) in enumerate(chunk):
-                out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
-        for k, rs in out.items():
-            self.cache[k] = (np.mean([r[0] for r in rs], axis=0), np.all([r[1] for r in rs], axis=0),
-                             all(r[2] for r in rs), float(np.mean([r[3] for r in rs])))
-        return [self.cache[k] for k in keys]
-
-    def gradient_ad(self, q, R, meas, valid) -> np.ndarray:
-        """(p,) gradient of the section loss ``0.5 |R (y - meas)|^2`` by checkpointed reverse mode
-        through the whole run (one checkpoint per frame; the mean over the seeds)."""
-        args = (jnp.asarray(R, self.dtype), jnp.asarray(meas, self.dtype), jnp.asarray(valid))
-        g = [np.asarray(_grad(jnp.asarray(q, self.dtype), self.dz[i], self.rig, self.lines, *args, static=self.static), float)
-             for i in range(self.seeds)]
-        self.runs += self.seeds
-        return np.mean(g, axis=0)
-
-
-def predict_sections(case, sections: Sequence, law=None, *, shear_scale: float = 1.0, ply: int = 1) -> list:
-    """The amplitude d_P (m) the forming run of ``case`` with ``law`` (default the case's) gives at each
-    section's points (the fit's own program): ``[(y (m,), valid (m,)), ...]``; a held-out check."""
-    kind = "voce" if shear_scale == 1.0 else "voce+shear"
-    for s in sections:
-        sec_mod.check_section(s, case)
-    runs = _Runs(case, sections, kind, 1, 0.0, 1, ply)
-    q = np.append(q_from_law(voce_start(law) if law is not None else runs.law0, "voce"),
-                  [] if kind == "voce" else [math.log(shear_scale)])
-    y, valid, ok, _ = runs.evaluate([q])[0]
-    if not ok:
-        raise RuntimeError(f"predict_sections: the forming run of case {case.name!r} with this law failed")
-    cuts = np.cumsum([0] + [len(s.s) for s in sections])
-    return [(y[a:b], valid[a:b]) for a, b in zip(cuts[:-1], cuts[1:])]
-
-
-def sections_of(case, lines: dict, law=None, *, spacing: float = 1e-3, ply: int = 1) -> list:
-    """The sections ``{name: ((x0, y0), (x1, y1))}`` (m, top view) of the part ``case`` forms with
-    ``law`` (default the case's): a point every ``spacing`` m, those on the part, d_P as amplitude."""
-    raw = []
-    for name, (a, b) in lines.items():
-        a, b = np.asarray(a, float), np.asarray(b, float)
-        n = int(round(float(np.linalg.norm(b - a)) / spacing)) + 1
-        raw.append(sec_mod.Section(s=np.linspace(0.0, np.linalg.norm(b - a), n), amplitude=np.zeros(n), start=a, end=b,
-                                   name=name))
-    return [dataclasses.replace(s, s=s.s[np.asarray(v, bool)], amplitude=np.asarray(y, float)[np.asarray(v, bool)])
-            for s, (y, v) in zip(raw, predict_sections(case, raw, law, ply=ply))]
-
-
 def section_loss(case, sections: Sequence, qs, *, noise: float = NOISE, smoothing: float | None = None, ply: int = 1,
                  gradient_at: Sequence[int] = ()) -> tuple[np.ndarray, dict]:
     """The fit's section loss ``0.5 |R (y - meas)|^2`` at each log-space law ``qs`` (k, 3)
@@ -275,7 +141,7 @@ def section_loss(case, sections: Sequence, qs, *, noise: float = NOISE, smoothin
     run fails. The loss along a line in parameter space shows how rough the landscape is."""
     for s in sections:
         sec_mod.check_section(s, case)
-    runs = _Runs(case, sections, "voce", 1, 0.0, 1, ply)
+    runs = SectionRuns(case, sections, "voce", 1, 0.0, 1, ply)
     R = sec_mod.weights(sections, noise, smoothing if smoothing is not None else float(case.element_size))
     meas = np.concatenate([s.amplitude for s in sections])
     qs = [np.asarray(q, float) for q in qs]
@@ -343,7 +209,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     if batch_width is None:
         batch_width = 1 if jax.default_backend() == "cpu" else 2 * p
     imperfection = 0.1 * case.ply_thickness if imperfection is None else float(imperfection)
-    runs = _Runs(case, sections, params, int(seeds), imperfection, batch_width, ply)
+    runs = SectionRuns(case, sections, params, int(seeds), imperfection, batch_width, ply)
     R = sec_mod.weights(sections, noise, width)  # (rows, M): y -> section rows
     cuts = np.cumsum([0] + [len(s.s) for s in sections])
     meas = np.concatenate([s.amplitude for s in sections])

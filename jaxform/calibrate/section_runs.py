@@ -1,0 +1,176 @@
+"""The forming runs of the wrinkle-section fit (:mod:`jaxform.calibrate.wrinkle_fit`): the rig built
+once, each trial law one ``forming.rollout`` of the whole stroke, batched over
+:data:`jaxform.batching.BATCH_AXIS`, the amplitude d_P sampled along the sections, and reverse-mode
+gradients of a section loss through the run. A run that fails with the fast fibre mass (no momentum
+term) is run again with the term, as :func:`jaxform.forming.run` switches it on. Host results are
+cached by law. SI units.
+"""
+from __future__ import annotations
+
+import dataclasses
+import functools
+import math
+from typing import NamedTuple, Sequence
+
+import jax
+import jax.numpy as jnp
+import numpy as np
+
+from jaxform import forming
+from jaxform.batching import BATCH_AXIS
+from jaxform.calibrate import sections as sec_mod
+from jaxform.calibrate.imperfections import imperfections
+from jaxform.calibrate.transforms import law_from_q, q_from_law, scaled_shear, voce_start
+from jaxform.contact import ToolLoad
+from jaxform.forming.fields import state_fields
+from jaxform.shell import fibre_curvatures
+
+GRAD_FRAMES = 21  # the fit's rig has this many frames: one checkpoint each in the reverse pass
+KAPPA_PERCENTILE = 98.0  # "the curvatures the wrinkles reach": this percentile of |kappa| on the fitted part
+
+
+class _Steps(NamedTuple):
+    """What :func:`jaxform.forming.rollout` reads of a run's info (hashable: a static argument)."""
+
+    n_frames: int
+    every: int
+
+
+def _member(q, dz, rig, lines, static):
+    """One forming run with the law ``q`` from the blank perturbed by ``dz``: ``(y, valid, ok, kappa_reach)``."""
+    kind, n_plies, steps, ns, checkpoint = static
+    model, state, fabric, ply_id, sel, faces = rig
+    q = q.astype(state.x.dtype)
+    law = law_from_q(q[:3], "voce")
+    fab = fabric.replace(bending=(law, law))
+    if kind == "voce+shear":
+        fab = fab.replace(shear=scaled_shear(fab.shear, jnp.exp(q[3])))
+    m = forming.with_fabric(model, fab)
+    st = dataclasses.replace(state, x=state.x + dz, u=state.u + dz.T)
+    s, _ = forming.rollout(m, st, steps, checkpoint=checkpoint)
+    dev = state_fields(m, s, ply_id, n_plies)["deviation"]
+    x, d = s.x[sel], dev[sel]
+    vals, oks = zip(*(sec_mod.simulated(x, faces, d, a, b, sq, n) for (a, b, sq), n in zip(lines, ns)))
+    y = jnp.concatenate(vals)
+    kappa = fibre_curvatures(s.x, m.shell.mesh, m.shell.ref)[sel]
+    reach = jnp.percentile(jnp.abs(kappa), KAPPA_PERCENTILE)
+    return y, jnp.concatenate(oks), (s.bad_step < 0) & jnp.all(jnp.isfinite(y)), reach
+
+
+@functools.partial(jax.jit, static_argnames=("static",))
+def _batch(Q, Z, rig, lines, static):
+    """:func:`_member` over a batch (one compiled program per rig shape, shared by every fit in a process)."""
+    return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static), axis_name=BATCH_AXIS)(Q, Z)
+
+
+@functools.partial(jax.jit, static_argnames=("static",))
+def _grad(q, dz, rig, lines, R, meas, valid, static):
+    """Gradient of ``0.5 |R (y - meas)|^2`` (``y`` masked by ``valid``), checkpointed reverse mode."""
+    def loss(q):
+        r = R @ jnp.where(valid, _member(q, dz, rig, lines, static[:-1] + (True,))[0] - meas, 0.0)
+        return 0.5 * jnp.sum(r * r)
+
+    return jax.grad(loss)(q)
+
+
+def _key(q) -> tuple:
+    return tuple(np.round(np.asarray(q, float), 12).tolist())
+
+
+class SectionRuns:
+    """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``."""
+
+    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply):
+        rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)))
+        model, state, info = rig
+        fab = model.shell.fabrics[0]
+        if fab.bending is None:
+            raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
+        if not 1 <= ply <= case.n_plies:
+            raise ValueError(f"fit_wrinkles: ply = {ply}: the case has plies 1..{case.n_plies}")
+        self.law0, self.width, self.seeds = voce_start(fab.bending[0]), int(width), int(seeds)
+        self.dtype = state.x.dtype
+        sel = np.asarray(info.ply_id) == ply
+        local = np.cumsum(sel) - 1
+        faces = local[info.faces[np.all(sel[info.faces], axis=1)]]
+        self.rig = (model, state, fab, jnp.asarray(info.ply_id), jnp.asarray(np.flatnonzero(sel)), jnp.asarray(faces))
+        exact = forming.with_momentum_term(model)  # a run that fails without it is run again with it (forming.run)
+        self.rigs = (self.rig,) if exact is None else (self.rig, (exact,) + self.rig[1:])
+        self.exact: set = set()  # the laws (keys) that needed the term
+        self.lines = tuple((jnp.asarray(s.start, self.dtype), jnp.asarray(s.end, self.dtype), jnp.asarray(s.s, self.dtype))
+                           for s in sections)
+        ns = tuple(sec_mod.n_samples(s, case.element_size) for s in sections)
+        self.static = (param_kind, case.n_plies, _Steps(info.n_frames, info.every), ns, False)
+        clearance = np.min([np.asarray(ld.gap(state.x, state.t, ls), float) for ld, ls in zip(model.loads, state.loads)
+                            if isinstance(ld, ToolLoad)] or [np.full(len(info.x0), np.inf)], axis=0)
+        self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size, clearance), self.dtype)
+        self.cache: dict = {}
+        self.runs = 0
+
+    def evaluate(self, qs: Sequence[np.ndarray]) -> list:
+        """``(y (M,), valid (M,), ok, kappa_reach)`` per ``q``, the mean over the seeds (host)."""
+        keys = [_key(q) for q in qs]
+        todo = [k for k in dict.fromkeys(keys) if k not in self.cache]
+        members = [(k, i) for k in todo for i in range(self.seeds)]
+        out: dict = {}
+        for a in range(0, len(members), self.width):
+            chunk = members[a:a + self.width]
+            pad = chunk + [chunk[-1]] * (self.width - len(chunk))
+            Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
+            Z = self.dz[np.array([i for _, i in pad])]
+            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
+            self.runs += len(chunk)
+            bad = ~ok
+            if bad[:len(chunk)].any() and len(self.rigs) > 1:
+                y, v, ok, reach = (np.where(bad.reshape((-1,) + (1,) * (a.ndim - 1)), np.asarray(b), a) for a, b in
+                                   zip((y, v, ok, reach), _batch(Q, Z, self.rigs[1], self.lines, self.static)))
+                self.exact |= {k for (k, _), b in zip(chunk, bad) if b}
+                self.runs += len(chunk)
+            for j, (k, _) in enumerate(chunk):
+                out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
+        for k, rs in out.items():
+            self.cache[k] = (np.mean([r[0] for r in rs], axis=0), np.all([r[1] for r in rs], axis=0),
+                             all(r[2] for r in rs), float(np.mean([r[3] for r in rs])))
+        return [self.cache[k] for k in keys]
+
+    def gradient_ad(self, q, R, meas, valid) -> np.ndarray:
+        """(p,) gradient of the section loss ``0.5 |R (y - meas)|^2`` by checkpointed reverse mode
+        through the whole run (one checkpoint per frame; the mean over the seeds)."""
+        args = (jnp.asarray(R, self.dtype), jnp.asarray(meas, self.dtype), jnp.asarray(valid))
+        rig = self.rigs[-1] if _key(q) in self.exact else self.rig
+        g = [np.asarray(_grad(jnp.asarray(q, self.dtype), self.dz[i], rig, self.lines, *args, static=self.static), float)
+             for i in range(self.seeds)]
+        self.runs += self.seeds
+        return np.mean(g, axis=0)
+
+
+def predict_sections(case, sections: Sequence, law=None, *, shear_scale: float = 1.0, ply: int = 1) -> list:
+    """The amplitude d_P (m) the forming run of ``case`` with ``law`` (default the case's) gives at each
+    section's points (the fit's own program): ``[(y (m,), valid (m,)), ...]``; a held-out check."""
+    kind = "voce" if shear_scale == 1.0 else "voce+shear"
+    for s in sections:
+        sec_mod.check_section(s, case)
+    runs = SectionRuns(case, sections, kind, 1, 0.0, 1, ply)
+    q = np.append(q_from_law(voce_start(law) if law is not None else runs.law0, "voce"),
+                  [] if kind == "voce" else [math.log(shear_scale)])
+    y, valid, ok, _ = runs.evaluate([q])[0]
+    if not ok:
+        raise RuntimeError(f"predict_sections: the forming run of case {case.name!r} with this law failed")
+    cuts = np.cumsum([0] + [len(s.s) for s in sections])
+    return [(y[a:b], valid[a:b]) for a, b in zip(cuts[:-1], cuts[1:])]
+
+
+def sections_of(case, lines: dict, law=None, *, spacing: float = 1e-3, ply: int = 1) -> list:
+    """The sections ``{name: ((x0, y0), (x1, y1))}`` (m, top view) of the part ``case`` forms with
+    ``law`` (default the case's): a point every ``spacing`` m, those on the part, d_P as amplitude."""
+    raw = []
+    for name, (a, b) in lines.items():
+        a, b = np.asarray(a, float), np.asarray(b, float)
+        n = int(round(float(np.linalg.norm(b - a)) / spacing)) + 1
+        raw.append(sec_mod.Section(s=np.linspace(0.0, np.linalg.norm(b - a), n), amplitude=np.zeros(n), start=a, end=b,
+                                   name=name))
+    return [dataclasses.replace(s, s=s.s[np.asarray(v, bool)], amplitude=np.asarray(y, float)[np.asarray(v, bool)])
+            for s, (y, v) in zip(raw, predict_sections(case, raw, law, ply=ply))]
+
+
+__all__ = ["GRAD_FRAMES", "KAPPA_PERCENTILE", "SectionRuns", "predict_sections", "sections_of"]

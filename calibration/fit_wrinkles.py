@@ -153,7 +153,7 @@ def _run(args, section_args, profile_args) -> int:
         print(f"{PROG}: error: {err}", file=sys.stderr)
         return 2
     p = 3 if args.params == "voce" else 4
-    progress = _Progress(args.progress_every, args.starts + 3 * p + 1 + args.max_iter * (p + 1))
+    progress = _Progress(args.progress_every, args.starts + 3 * p + 1 + args.max_iter * (2 * p + 1))
     try:
         fit = wrinkle_fit.fit_wrinkles(
             case, sections, params=args.params, profiles=profiles or None,

@@ -26,10 +26,12 @@ Jacobian only where they agree within :data:`GRAD_RTOL` (else forward difference
 seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and (4) runs
 ``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there; (5) where a probe of
 the final Jacobian at the best law fits better by more than :data:`MOVE_RTOL` (the optimiser stopped
-on a rough wall), it moves there and probes again (``moves_after_optimiser``). The loss is
-multimodal: on woven Case A at 8 mm a law with 1.9x the true B_init fits two sections to loss
-1,715 (truth 260) behind a barrier of 54,000 on the straight line between them, at every
-smoothing width from 8 to 40 mm (the buckling branch changes, not a wrinkle's position). Optional
+on a rough wall), it moves there and probes again (``moves_after_optimiser``). Fit at a
+quasi-static speed (the presets' automatic one): on woven Case A at 8 mm and 500 mm/s (8x that
+speed) the loss is multimodal, a law with 1.9x the true B_init fitting two sections to loss 1,715
+(truth 260) behind a barrier of 54,000 on the straight line between them at every smoothing width
+from 8 to 40 mm (the inertia-driven buckling branch changes); at the automatic 62.5 mm/s the same
+line has no barrier (28,336 falling to 51 at the truth, one bump of 1,100). Optional
 ``seeds > 1`` averages each evaluation over seeded imperfections of the blank (a smooth random
 out-of-plane field of amplitude ``imperfection``, tapered to 0 near the tools), batched.
 

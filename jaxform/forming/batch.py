@@ -392,8 +392,8 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
             if not active[:B].any():
                 break
         for i in range(B):  # as its own run would: a fast fibre mass that failed goes on with its exact term
-            at = Standing(_member(model, axes, i), last_good[i])
-            if last_good[i] is None or not at.switch(recs[i], causes[i]):
+            at = None if last_good[i] is None else Standing(_member(model, axes, i), last_good[i])
+            if at is None or not at.switch(recs[i], causes[i]):
                 continue
             alone[i] = at
             try:

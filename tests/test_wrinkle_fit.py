@@ -3,6 +3,7 @@ the position-tolerant residual, the pieces of the fit, and the script's refusals
 runs end to end in notebook 07's test and in ``benchmarks/bench_wrinkle_fit.py``."""
 import math
 import re
+import threading
 
 import jax.numpy as jnp
 import numpy as np
@@ -134,28 +135,34 @@ def test_the_fit_s_imperfect_blanks_start_clear_of_the_tools():
                 assert np.all(gap >= np.minimum(gap0, 0.0) - 1e-12)  # nobody pushed into a tool
 
 
-def test_a_fit_run_that_fails_without_the_momentum_term_is_run_again_with_it(monkeypatch):
+@pytest.mark.parametrize("width,workers", [(2, 1), (1, 2)])
+def test_a_fit_run_that_fails_without_the_momentum_term_is_run_again_with_it(monkeypatch, width, workers):
     """As ``forming.run`` switches the fibre mass's momentum term on where a chunk fails without it
     (tested in test_fibre_mass), the fit runs a law again with the term where its run failed, and
-    keeps the first result of the laws that did not fail. Wiring only: the program is stubbed, the
-    flag of the fibre mass tells which rig it got."""
+    keeps the first result of the laws that did not fail; the same when the batches run in two
+    threads at once (a CPU's cores: both must be inside the program together). Wiring only: the
+    program is stubbed, the flag of the fibre mass tells which rig it got."""
     case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
     sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
                   end=np.array([0.09, 0.0]))
-    runs = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 2, 1)
+    runs = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, width, 1, workers)
     assert not runs.rig[0].fibre_mass.geometric and runs.rigs[1][0].fibre_mass.geometric
     m = len(sec.s)
+    together = threading.Barrier(workers, timeout=30)
 
     def stub(Q, Z, rig, lines, static):  # law 0 fails without the term; the exact rig's results are 2 and 3
         exact = rig[0].fibre_mass.geometric
+        if not exact:
+            together.wait()
         y = np.full((len(Q), m), 2.0 if exact else 1.0)
-        ok = np.array([True, True]) if exact else np.asarray(Q)[:, 0] > -5.0
+        ok = np.ones(len(Q), bool) if exact else np.asarray(Q)[:, 0] > -5.0
         return y, np.ones((len(Q), m), bool), ok, np.full(len(Q), 3.0 if exact else 1.0)
 
     monkeypatch.setattr(section_runs, "_batch", stub)
     (y0, _, ok0, r0), (y1, _, ok1, r1) = runs.evaluate([np.array([-6.0, -1.0, 3.0]), np.array([-4.0, -1.0, 3.0])])
     assert ok0 and ok1 and np.all(y0 == 2.0) and r0 == 3.0 and np.all(y1 == 1.0) and r1 == 1.0
-    assert runs.exact == {section_runs._key(np.array([-6.0, -1.0, 3.0]))} and runs.runs == 4
+    assert runs.exact == {section_runs._key(np.array([-6.0, -1.0, 3.0]))}
+    assert runs.runs == 2 + width  # both laws, and the failed one's batch again with the term
 
 
 def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):

@@ -10,6 +10,8 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import os
+from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple, Sequence
 
 import jax
@@ -77,10 +79,25 @@ def _key(q) -> tuple:
     return tuple(np.round(np.asarray(q, float), 12).tolist())
 
 
-class SectionRuns:
-    """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``."""
+def cores() -> int:
+    """The cores this process may use."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
-    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply):
+
+def parallel(width: int | None, workers: int | None, wide: int) -> tuple[int, int]:
+    """``(width, workers)`` of :class:`SectionRuns` where not given: on a CPU one member per batch and
+    a batch per core at once (threads: the small programs use a core each), else ``wide`` members
+    per batch, one batch at a time (an accelerator runs a batch's members together)."""
+    cpu = jax.default_backend() == "cpu"
+    return (int(width) if width is not None else 1 if cpu else int(wide),
+            int(workers) if workers is not None else cores() if cpu else 1)
+
+
+class SectionRuns:
+    """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``;
+    ``workers`` batches at a time (threads: a CPU's cores each run one)."""
+
+    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply, workers=1):
         rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)))
         model, state, info = rig
         fab = model.shell.fabrics[0]
@@ -88,7 +105,7 @@ class SectionRuns:
             raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
         if not 1 <= ply <= case.n_plies:
             raise ValueError(f"fit_wrinkles: ply = {ply}: the case has plies 1..{case.n_plies}")
-        self.law0, self.width, self.seeds = voce_start(fab.bending[0]), int(width), int(seeds)
+        self.law0, self.width, self.seeds, self.workers = voce_start(fab.bending[0]), int(width), int(seeds), int(workers)
         self.dtype = state.x.dtype
         sel = np.asarray(info.ply_id) == ply
         local = np.cumsum(sel) - 1
@@ -112,26 +129,36 @@ class SectionRuns:
         keys = [_key(q) for q in qs]
         todo = [k for k in dict.fromkeys(keys) if k not in self.cache]
         members = [(k, i) for k in todo for i in range(self.seeds)]
+        chunks = [members[a:a + self.width] for a in range(0, len(members), self.width)]
+        if self.workers > 1 and len(chunks) > 1:
+            with ThreadPoolExecutor(min(self.workers, len(chunks))) as pool:
+                done = list(pool.map(self._chunk, chunks))
+        else:
+            done = [self._chunk(c) for c in chunks]
         out: dict = {}
-        for a in range(0, len(members), self.width):
-            chunk = members[a:a + self.width]
-            pad = chunk + [chunk[-1]] * (self.width - len(chunk))
-            Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
-            Z = self.dz[np.array([i for _, i in pad])]
-            y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
-            self.runs += len(chunk)
-            bad = ~ok
-            if bad[:len(chunk)].any() and len(self.rigs) > 1:
-                y, v, ok, reach = (np.where(bad.reshape((-1,) + (1,) * (a.ndim - 1)), np.asarray(b), a) for a, b in
-                                   zip((y, v, ok, reach), _batch(Q, Z, self.rigs[1], self.lines, self.static)))
-                self.exact |= {k for (k, _), b in zip(chunk, bad) if b}
-                self.runs += len(chunk)
+        for chunk, (y, v, ok, reach, runs, exact) in zip(chunks, done):
+            self.runs += runs
+            self.exact |= exact
             for j, (k, _) in enumerate(chunk):
                 out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
         for k, rs in out.items():
             self.cache[k] = (np.mean([r[0] for r in rs], axis=0), np.all([r[1] for r in rs], axis=0),
                              all(r[2] for r in rs), float(np.mean([r[3] for r in rs])))
         return [self.cache[k] for k in keys]
+
+    def _chunk(self, chunk):
+        """One batch ``[(key, seed), ...]``: host ``(y, valid, ok, reach)``, the runs it took and the
+        laws that needed the momentum term (run again with it where they failed without)."""
+        pad = chunk + [chunk[-1]] * (self.width - len(chunk))
+        Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
+        Z = self.dz[np.array([i for _, i in pad])]
+        y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
+        bad = ~ok
+        if not (bad[:len(chunk)].any() and len(self.rigs) > 1):
+            return y, v, ok, reach, len(chunk), set()
+        y, v, ok, reach = (np.where(bad.reshape((-1,) + (1,) * (a.ndim - 1)), np.asarray(b), a) for a, b in
+                           zip((y, v, ok, reach), _batch(Q, Z, self.rigs[1], self.lines, self.static)))
+        return y, v, ok, reach, 2 * len(chunk), {k for (k, _), b in zip(chunk, bad) if b}
 
     def gradient_ad(self, q, R, meas, valid) -> np.ndarray:
         """(p,) gradient of the section loss ``0.5 |R (y - meas)|^2`` by checkpointed reverse mode

@@ -8,15 +8,13 @@ with it the default suite took 15 min on a fresh clone of the 2-core machine, ov
 budget; ``pytest -m slow tests/test_notebook_07.py`` runs it.
 
 The quick fit cannot converge in three evaluations; what is checked is that its verdict is honest:
-a fit whose smoothed rows stay more than ``CHI_LIMIT`` noise sds RMS off the data says
-``converged: False`` and why, and one that did not lower the loss says that too.
+a fit whose smoothed rows stay more than 3 noise sds RMS off the data (a chi-square 9x its
+expectation: beyond any noise) says ``converged: False`` and why, and one that did not lower the loss says that too.
 """
 import re
 
 import pytest
 from notebook_runner import run_notebook
-
-from jaxform.calibrate.wrinkle_fit import CHI_LIMIT
 
 
 @pytest.mark.slow
@@ -29,9 +27,9 @@ def test_notebook_07_runs(tmp_path, monkeypatch):
     loss0, loss1, chi = (float(g) for g in m.groups())
     assert loss1 <= loss0  # the best law seen is returned; the start is one of them
     reason = re.search(r"reason: (.*)", text).group(1)
-    if chi > CHI_LIMIT:
+    if chi > 3.0:
         assert "converged: False" in text
-        assert "noise sds RMS" in reason
+        assert "more than the noise explains" in reason
     if not loss1 < loss0:
         assert "no law lowered the loss" in reason
     assert re.search(r"held-out section, fitted law: RMS [0-9.]+ mm", text)

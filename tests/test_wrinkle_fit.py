@@ -225,6 +225,32 @@ def test_fit_wrinkles_script_refuses_before_running(tmp_path, capsys):
     assert rc == 2 and "--areal-mass-gsm" in err
 
 
+def test_misfit_is_the_noise_s_own_chi_square_at_the_true_law():
+    """What the fit calls a misfit beyond the noise (jaxform.calibrate.uncertainty.misfit): the
+    smoothed section rows' chi-square under the measurement noise alone (correlated rows) has the
+    mean and variance ``chi_square_moments`` says (against 40,000 draws of the noise: 2 % and 6 %),
+    its p-values are calibrated (1 % of those draws below p = 0.01, within 0.5-2 %), for
+    independent rows they are the chi-square distribution's own, and a chi-square 12 sds out (the
+    joint fit's local minimum at 62.5 mm/s) is inconsistent."""
+    from scipy.stats import chi2
+
+    from jaxform.calibrate.uncertainty import MISFIT_P, misfit
+
+    secs = [Section(s=np.linspace(0.0, L, n), amplitude=np.zeros(n), start=np.array([0.06, 0.0]),
+                    end=np.array([0.06 + L, 0.0])) for L, n in ((0.1, 101), (0.06, 41))]
+    R = S.weights(secs, 5e-5, 8e-3)
+    mean, var = S.chi_square_moments(R, 5e-5)
+    draws = np.sum((R @ (5e-5 * np.random.default_rng(3).standard_normal((R.shape[1], 40_000)))) ** 2, axis=0)
+    assert mean == pytest.approx(R.shape[0]) and np.mean(draws) == pytest.approx(mean, rel=0.02)
+    assert np.var(draws) == pytest.approx(var, rel=0.06) and var > 4.0 * 2 * R.shape[0]  # far from independent
+    p = np.array([misfit(c, mean, var)["p_value"] for c in draws[:4000]])
+    assert 0.005 <= np.mean(p < 0.01) <= 0.02
+    assert misfit(130.0, 100.0, 200.0)["p_value"] == pytest.approx(chi2.sf(130.0, 100), rel=1e-9)
+    assert misfit(mean, mean, var)["consistent"]
+    out = misfit(mean + 12.0 * math.sqrt(var), mean, var)
+    assert not out["consistent"] and out["p_value"] < MISFIT_P
+
+
 def test_checked_covariance_keeps_a_quadratic_loss_and_widens_a_jacobian_steeper_than_the_loss():
     """jaxform.calibrate.uncertainty: on a linear least-squares problem the probes measure exactly
     the quadratic model's rise (nothing widened); a Jacobian 10x steeper than the loss (what a rough

@@ -3,7 +3,7 @@ Run: python 20261204T-fit-workers.py 8e-3 OUT.json"""
 import json, sys, time
 import numpy as np
 B = str(__import__("pathlib").Path(__file__).resolve().parents[1])
-import importlib.util, pathlib
+import importlib.util
 spec = importlib.util.spec_from_file_location("bw", B + "/bench_wrinkle_fit.py"); bw = importlib.util.module_from_spec(spec); spec.loader.exec_module(bw)
 import dataclasses
 from jaxform import cases

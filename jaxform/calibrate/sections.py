@@ -117,6 +117,13 @@ def weights(sections, noise: float, width: float) -> np.ndarray:
     return block_diag(*[W / row_scale(W, noise)[:, None] for W in Ws])
 
 
+def chi_square_moments(R: np.ndarray, noise: float) -> tuple[float, float]:
+    """Mean and variance of ``|R e|^2`` for measurement noise ``e ~ N(0, noise^2 I)``: the section
+    rows' chi-square at the true law (``R`` of :func:`weights`; rows correlated by the smoothing)."""
+    C = noise * noise * (R @ R.T)
+    return float(np.trace(C)), float(2.0 * np.sum(C * C))
+
+
 def independent_points(sec: Section, width: float) -> float:
     """About how many independent residuals the smoothed section holds (``length / (2 sqrt(pi) w)``, at most m)."""
     if width <= 0:

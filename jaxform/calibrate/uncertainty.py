@@ -19,6 +19,9 @@ import numpy as np
 
 PROBE_SDS = 2.0
 """The probes lie this many (Laplace) standard deviations either side of the fit."""
+MISFIT_P = 1e-3
+"""A fit is consistent with its noise where the noise alone, at the true law, would leave a
+chi-square at least as large with this probability or more (:func:`misfit`)."""
 MIN_RATIO = 1e-12
 """A loss that did not rise widens a standard deviation by 1e6 (finite: a derived quantity that
 does not depend on that parameter keeps its own)."""
@@ -103,3 +106,18 @@ def _json(v):
 
 
 __all__ = ["PROBE_SDS", "MIN_RATIO", "checked_covariance"]
+
+
+def misfit(chi2: float, mean: float, var: float) -> dict:
+    """How likely the measurement noise alone leaves a chi-square of at least ``chi2`` at the true
+    law, where the rows' chi-square has mean ``mean`` and variance ``var`` there (correlated rows:
+    smoothed sections): a scaled chi-square ``a chi2_k`` with those moments (``a = var / 2 mean``,
+    ``k = 2 mean^2 / var``). ``consistent``: ``p_value >= MISFIT_P``. A fit far above it sits in a
+    local minimum, has the wrong form of law, or was given too little noise; its Laplace standard
+    deviations then describe that minimum only."""
+    from scipy.stats import chi2 as scaled
+
+    a, k = var / (2.0 * mean), 2.0 * mean * mean / var
+    p = float(scaled.sf(chi2 / a, k))
+    return {"chi_square": float(chi2), "expected": float(mean), "sd": math.sqrt(var), "p_value": p,
+            "limit": MISFIT_P, "consistent": p >= MISFIT_P}

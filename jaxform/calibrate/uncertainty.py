@@ -105,8 +105,6 @@ def _json(v):
     return float(v) if math.isfinite(v) else None
 
 
-__all__ = ["PROBE_SDS", "MIN_RATIO", "checked_covariance"]
-
 
 def misfit(chi2: float, mean: float, var: float) -> dict:
     """How likely the measurement noise alone leaves a chi-square of at least ``chi2`` at the true
@@ -121,3 +119,6 @@ def misfit(chi2: float, mean: float, var: float) -> dict:
     p = float(scaled.sf(chi2 / a, k))
     return {"chi_square": float(chi2), "expected": float(mean), "sd": math.sqrt(var), "p_value": p,
             "limit": MISFIT_P, "consistent": p >= MISFIT_P}
+
+
+__all__ = ["PROBE_SDS", "MISFIT_P", "MIN_RATIO", "checked_covariance", "misfit"]

@@ -8,6 +8,8 @@ batch takes it (a search refreshed early, or every node evaluated, is still exac
 """
 from __future__ import annotations
 
+import os
+
 import jax
 import jax.numpy as jnp
 
@@ -25,4 +27,9 @@ def any_member(pred):
         return pred
 
 
-__all__ = ["BATCH_AXIS", "any_member"]
+__all__ = ["BATCH_AXIS", "any_member", "cores"]
+
+
+def cores() -> int:
+    """The CPU cores this process may use (its affinity where the system tells it)."""
+    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)

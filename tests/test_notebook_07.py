@@ -9,7 +9,8 @@ budget; ``pytest -m slow tests/test_notebook_07.py`` runs it.
 
 The quick fit cannot converge in three evaluations; what is checked is that its verdict is honest:
 a fit whose smoothed rows stay more than 3 noise sds RMS off the data (a chi-square 9x its
-expectation: beyond any noise) says ``converged: False`` and why, and one that did not lower the loss says that too.
+expectation: beyond any noise) says ``converged: False`` and why, and one that did not lower the
+loss says that too.
 """
 import re
 

@@ -10,7 +10,6 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
-import os
 from concurrent.futures import ThreadPoolExecutor
 from typing import NamedTuple, Sequence
 
@@ -19,7 +18,7 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform import forming
-from jaxform.batching import BATCH_AXIS
+from jaxform.batching import BATCH_AXIS, cores
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.transforms import law_from_q, q_from_law, scaled_shear, voce_start
@@ -77,11 +76,6 @@ def _grad(q, dz, rig, lines, R, meas, valid, static):
 
 def _key(q) -> tuple:
     return tuple(np.round(np.asarray(q, float), 12).tolist())
-
-
-def cores() -> int:
-    """The cores this process may use."""
-    return len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
 
 
 def parallel(width: int | None, workers: int | None, wide: int) -> tuple[int, int]:

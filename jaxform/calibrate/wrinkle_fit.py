@@ -19,11 +19,12 @@ fibre mass's momentum term is run again with it, as ``forming.run`` would
 Why not plain gradients. Reverse mode through the run is exact (it equals central differences at
 ``h = 1e-8``), but the buckled flange is chaotically sensitive to the law: over a whole stroke
 the exact derivative grows like ``e^{lambda t}`` and says nothing about the loss over any finite
-step (woven Case A in float64: about 1e277 against central differences of 1e6 at 8 mm and 500 mm/s;
-at the automatic 62.5 mm/s, 8x the steps, it overflows to NaN already at 16 mm). So the fit (1) checks at the start the AD gradient of the actual loss against central
-differences with its step ``fd_step`` (0.05 in log space) and records both, (2) uses the AD
-Jacobian only where they agree within :data:`GRAD_RTOL` (else forward differences with
-``fd_step``, said in ``gradient_check``), (3) starts from the best of the starting law and a
+step (woven Case A in float64: about 1e277 against central differences of 1e6 at 8 mm and
+500 mm/s; at the automatic 62.5 mm/s, 8x the steps, it overflows to NaN already at 16 mm). So the
+fit (1) checks at the start the AD gradient of the actual loss against central differences with
+its step ``fd_step`` (0.05 in log space) and records both, (2) uses the AD Jacobian only where
+they agree within :data:`GRAD_RTOL` (else forward differences with ``fd_step``, said in
+``gradient_check``), (3) starts from the best of the starting law and a
 seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and (4) runs
 ``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there; (5) where a probe of
 the final Jacobian at the best law fits better by more than :data:`MOVE_RTOL` (the optimiser stopped

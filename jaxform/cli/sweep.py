@@ -32,6 +32,7 @@ import pathlib
 import re
 import sys
 
+from jaxform.batching import cores
 from jaxform.cli.progress import Progress
 from jaxform.cli.run import OUTPUTS, point_data, save_plots
 
@@ -188,7 +189,7 @@ def _cpu_devices(n):
     import jax
 
     if n is None:
-        n = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+        n = cores()
     if int(n) < 1:
         raise ValueError(f"--cpu-devices {n}: need at least 1")
     try:

@@ -5,7 +5,7 @@ through the forming simulation; jointly with cantilever side profiles when given
         [--section B.csv --line ...] [--profile P.csv --overhang-mm L ... --areal-mass-gsm W]
         [--params voce|voce+shear] --out params.json [--plot fit.png] [--force]
         [--element-size-mm S] [--set KEY=VALUE ...] [--noise-mm 0.05] [--smoothing-mm W] [--ply 1]
-        [--starts 8] [--max-iter 8] [--seeds 1] [--no-gradient-check]
+        [--starts 8] [--max-iter 8] [--restarts 2] [--seeds 1] [--no-gradient-check]
 
 A section CSV has the header ``s_mm,amplitude_mm``: the position along the line from (X0, Y0) in
 the top view of the formed part (mm, punch axis at the origin, as ``jaxform run`` writes it) and
@@ -22,7 +22,10 @@ widened where it rises less: ``sigma_check``; ``null`` where no finite sd exists
 (sd under 10 %), ``loss_initial``,
 ``loss_final``, ``rms_mm_per_section`` and ``nrmse_per_section`` (the paper's metric),
 ``gradient_check`` (AD vs central differences at the start and what the fit did about it),
-``iterations``, ``forming_runs``, ``wall_time_s``, ``converged`` and ``reason``. An existing --out
+``iterations``, ``forming_runs``, ``wall_time_s``, ``misfit`` (the chi-square against what the noise
+leaves at the true law), ``local_fits`` (each local fit: its start, final loss and misfit p; more than
+one where the first ended in a local minimum), ``cantilever_start`` (with profiles: the law they give
+alone, one of the starts), ``converged`` and ``reason``. An existing --out
 is never overwritten without --force.
 
 Exit status: 0 fitted; 1 a fit that is not to be used (params.json says ``converged: false`` and
@@ -80,6 +83,7 @@ def _pairs(ap, args):
         ap.error("--profile needs --areal-mass-gsm (the fabric's areal mass, g/m²)")
     for name, v, ok in (("--noise-mm", args.noise_mm, args.noise_mm > 0), ("--starts", args.starts, args.starts >= 1),
                         ("--max-iter", args.max_iter, args.max_iter >= 1), ("--seeds", args.seeds, args.seeds >= 1),
+                        ("--restarts", args.restarts, args.restarts >= 0),
                         ("--ply", args.ply, args.ply >= 1),
                         ("--smoothing-mm", args.smoothing_mm, args.smoothing_mm is None or args.smoothing_mm >= 0),
                         ("--areal-mass-gsm", args.areal_mass_gsm, args.areal_mass_gsm is None or args.areal_mass_gsm > 0),
@@ -116,6 +120,8 @@ def main(argv=None) -> int:
     ap.add_argument("--ply", type=int, default=1, help="the ply the sections measured (1 touches the punch)")
     ap.add_argument("--starts", type=int, default=8, help="laws scored in the global phase (default 8)")
     ap.add_argument("--max-iter", type=int, default=8, help="optimiser evaluations (default 8)")
+    ap.add_argument("--restarts", type=int, default=2,
+                    help="local fits from the next-best starts where a fit fails the misfit test (default 2)")
     ap.add_argument("--seeds", type=int, default=1, help="imperfect blanks averaged per evaluation (default 1)")
     ap.add_argument("--no-gradient-check", action="store_true", help="skip AD vs FD at the start (the fit uses FD)")
     ap.add_argument("--progress-every", type=float, default=30.0, metavar="S", help="seconds between progress lines")
@@ -159,7 +165,7 @@ def _run(args, section_args, profile_args) -> int:
             case, sections, params=args.params, profiles=profiles or None,
             areal_mass=None if args.areal_mass_gsm is None else units.gsm_to_kg_per_m2(args.areal_mass_gsm),
             noise=args.noise_mm * 1e-3, smoothing=None if args.smoothing_mm is None else args.smoothing_mm * 1e-3,
-            ply=args.ply, n_starts=args.starts, max_iter=args.max_iter, seeds=args.seeds,
+            ply=args.ply, n_starts=args.starts, max_iter=args.max_iter, restarts=args.restarts, seeds=args.seeds,
             gradient_check=not args.no_gradient_check, callback=progress)
     except ValueError as err:  # a section the case's rig cannot produce
         progress.close()

@@ -15,6 +15,7 @@ from jaxform.calibrate.sections import Section
 from jaxform.contact import ToolLoad
 from jaxform.calibrate import section_runs
 from jaxform.calibrate import wrinkle_fit as wf
+from jaxform.calibrate.uncertainty import MISFIT_P
 from jaxform.io import calibration_files as cf
 from jaxform.materials import LinearBending, PolynomialShear, VoceBending, preset
 from helpers import run_calibration_script
@@ -186,6 +187,41 @@ def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):
     seen = wf.section_loss(case, [sec], [fit.q])[0][0]
     assert fit.loss_final == pytest.approx(seen) and fit.loss_final < 0.8 * fit.loss_initial
     assert not fit.converged and "Gauss-Newton" in fit.reason  # still about 0.25 from the truth
+
+
+def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypatch):
+    """Where the local fit from the best start ends in a local minimum (its chi-square beyond what
+    the noise leaves at the true law), the fit runs the local phase again from the next-best starts
+    and keeps the best (step 6). The forming program is stubbed: the amplitude is a cubic in log
+    B_init, h(u) = u^3 - 3u + 2.5 with u = u* + 4 (q0 - q0_true) (u* its real root), whose square
+    has a local minimum at u = 1 (h = 0.5, ten noise sds a row) and the zero at the truth, plus
+    terms linear in the other two parameters; the starting law sits at u = 0, downhill of the trap."""
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
+    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
+                  end=np.array([0.09, 0.0]))
+    u_root = float(np.real(np.roots([1.0, 0.0, -3.0, 2.5])[np.isreal(np.roots([1.0, 0.0, -3.0, 2.5]))][0]))
+    q_start = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce")
+    q_true = q_start + [u_root / 4.0, -0.2, 0.2]
+    t = np.linspace(-1.0, 1.0, 31)
+    shape = np.stack([np.ones(31), t, t**2], 1)
+
+    def stub(Q, Z, rig, lines, static):
+        d = np.asarray(Q, float) - q_true
+        u = u_root + 4.0 * d[:, 0]
+        y = 1e-3 * np.stack([u**3 - 3.0 * u + 2.5, d[:, 1], d[:, 2]], 1) @ shape.T
+        return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
+
+    monkeypatch.setattr(section_runs, "_batch", stub)
+    kw = dict(n_starts=6, max_iter=20, gradient_check=False, smoothing=2e-3)  # rows ~unsmoothed: all three shapes tell
+    trapped = wf.fit_wrinkles(case, [sec], restarts=0, **kw)
+    assert len(trapped.local_fits) == 1 and not trapped.misfit["consistent"] and not trapped.converged
+    assert abs(4.0 * (trapped.q[0] - q_true[0]) + u_root - 1.0) < 0.1  # in the trap, u = 1
+    assert "local minimum" in trapped.reason and "after 1 local fit" in trapped.reason
+    fit = wf.fit_wrinkles(case, [sec], **kw)  # restarts=2: the third start leaves the trap
+    assert len(fit.local_fits) == 3 and all(f["misfit_p"] < MISFIT_P for f in fit.local_fits[:2])
+    assert fit.converged and fit.misfit["consistent"], fit.reason
+    assert np.max(np.abs(fit.q - q_true)) < 0.01 and fit.loss_final < 1e-3 * trapped.loss_final
+    assert fit.as_dict()["local_fits"][-1]["loss_final"] == pytest.approx(fit.loss_final)
 
 
 def _cli(argv, capsys):

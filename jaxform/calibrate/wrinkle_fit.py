@@ -24,11 +24,16 @@ step (woven Case A in float64: about 1e277 against central differences of 1e6 at
 fit (1) checks at the start the AD gradient of the actual loss against central differences with
 its step ``fd_step`` (0.05 in log space) and records both, (2) uses the AD Jacobian only where
 they agree within :data:`GRAD_RTOL` (else forward differences with ``fd_step``, said in
-``gradient_check``), (3) starts from the best of the starting law and a
-seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and (4) runs
-``scipy.optimize.least_squares`` (trust-region reflective, bounds) from there; (5) where a probe of
-the final Jacobian at the best law fits better by more than :data:`MOVE_RTOL` (the optimiser stopped
-on a rough wall), it moves there and probes again (``moves_after_optimiser``). Fit at a
+``gradient_check``), (3) scores the starting law, a
+seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and, with profiles,
+the law the cantilever profiles alone give (:func:`~jaxform.calibrate.fit_cantilever`, no forming
+run: on the joint benchmark it is within 2.5 % in B_init where the joint fit from the best
+hypercube law stopped 15 % off), and (4) runs ``scipy.optimize.least_squares`` (trust-region
+reflective, bounds) from the best; (5) where a probe of the final Jacobian at the best law fits
+better by more than :data:`MOVE_RTOL` (the optimiser stopped on a rough wall), it moves there and
+probes again (``moves_after_optimiser``); (6) where the result fails the misfit test below (a local
+minimum), it runs (4)-(5) again from the next-best starts, at most ``restarts`` more, and keeps the
+best (``local_fits`` lists each). Fit at a
 quasi-static speed (the presets' automatic one): on woven Case A at 8 mm and 500 mm/s (8x that
 speed) the loss is multimodal, a law with 1.9x the true B_init fitting two sections to loss 1,715
 (truth 260) behind a barrier of 54,000 on the straight line between them at every smoothing width
@@ -117,6 +122,8 @@ class WrinkleFit:
     covariance: np.ndarray  # of q, checked (sigma_check)
     sigma_check: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.checked_covariance
     misfit: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.misfit at the fitted law
+    local_fits: list = dataclasses.field(default_factory=list)  # steps (4)-(5) from each start tried (fit_wrinkles, step 6)
+    cantilever_start: dict | None = None  # the law of the profiles alone (joint fit), a start of step (3)
 
     def as_dict(self) -> dict:
         v, s = self.values, {k: (x if math.isfinite(x) else None) for k, x in self.sigma.items()}
@@ -132,7 +139,8 @@ class WrinkleFit:
                "moves_after_optimiser": self.moves,
                "forming_runs": self.forming_runs, "wall_time_s": self.wall_time, "converged": self.converged,
                "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts],
-               "sigma_check": self.sigma_check, "misfit": self.misfit}
+               "sigma_check": self.sigma_check, "misfit": self.misfit, "local_fits": self.local_fits,
+               "cantilever_start": self.cantilever_start}
         if self.profile_rmse is not None:
             out["profile_rmse_mm"] = 1e3 * self.profile_rmse
         return out
@@ -141,7 +149,7 @@ class WrinkleFit:
 class Progress(NamedTuple):
     """What :func:`fit_wrinkles` hands its ``callback``: the stage and the best loss so far."""
 
-    stage: str  # "start", "gradient check", "global", "fit"
+    stage: str  # "start", "gradient check", "cantilever", "global", "fit"
     forming_runs: int
     loss: float
     q: tuple
@@ -176,7 +184,7 @@ def _bounds(q0, kind):
 
 def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Sequence | None = None,
                  areal_mass: float | None = None, noise: float = NOISE, profile_noise: float | None = None,
-                 smoothing: float | None = None, ply: int = 1, n_starts: int = 8, max_iter: int = 8,
+                 smoothing: float | None = None, ply: int = 1, n_starts: int = 8, max_iter: int = 8, restarts: int = 2,
                  fd_step: float = FD_STEP, gradient_check: bool = True, seeds: int = 1,
                  imperfection: float | None = None, batch_width: int | None = None, workers: int | None = None,
                  profile_kwargs: dict | None = None, callback: Callable[[Progress], Any] | None = None) -> WrinkleFit:
@@ -194,6 +202,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         n_starts: laws scored in the global phase: the starting law and a Latin hypercube of
             ``n_starts - 1`` laws in the box :data:`START_HALF_WIDTH` around it (seeded: repeatable).
         max_iter: residual evaluations of the optimiser (``max_nfev``).
+        restarts: local fits from the next-best starts where a fit fails the misfit test (step 6).
         fd_step: log-space step of the finite differences.
         gradient_check: compare AD with central differences at the start (else: FD Jacobian).
         seeds: imperfect blanks averaged per evaluation (1: the perfect blank only).
@@ -215,7 +224,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         sec_mod.check_section(s, case)
     for name, v, ok in (("noise", noise, noise > 0), ("fd_step", fd_step, 0 < fd_step < 1),
                         ("seeds", seeds, int(seeds) >= 1), ("n_starts", n_starts, int(n_starts) >= 1),
-                        ("max_iter", max_iter, int(max_iter) >= 1), ("workers", workers, workers is None or int(workers) >= 1),
+                        ("max_iter", max_iter, int(max_iter) >= 1), ("restarts", restarts, int(restarts) >= 0),
+                        ("workers", workers, workers is None or int(workers) >= 1),
                         ("smoothing", smoothing, smoothing is None or smoothing >= 0)):
         if not ok:
             raise ValueError(f"fit_wrinkles: {name} = {v!r} is out of range")
@@ -240,11 +250,13 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     moments = (mean + _n_prof(prof), var + 2.0 * _n_prof(prof))  # the chi-square at the true law
     q0 = np.append(q_from_law(runs.law0, "voce"), [0.0] * (p - 3))
     lo, hi = _bounds(q0, params)
-    best = {"loss": math.inf, "q": q0}
+    best = {"loss": math.inf, "q": q0}  # of the whole fit (the callback's)
+    here = {"loss": math.inf, "q": q0}  # of the current local fit
 
     def report(stage, q, value):
-        if value < best["loss"]:
-            best.update(loss=value, q=np.asarray(q, float))
+        for b in (best, here):
+            if value < b["loss"]:
+                b.update(loss=value, q=np.asarray(q, float))
         if callback is not None:
             callback(Progress(stage, runs.runs, best["loss"], tuple(best["q"].tolist())))
 
@@ -312,32 +324,73 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
                              "the buckled run overflows)") + ": the fit uses Gauss-Newton with a forward-difference "
                             "Jacobian of that step instead")}
 
-    # (3) the global phase: the best of a few laws around the starting one
+    # (3) the global phase: the best of a few laws around the starting one (and the profiles' own)
     cands = [q0] + list(np.clip(q0 + (2.0 * LatinHypercube(d=p, seed=0).random(int(n_starts) - 1) - 1.0)
                                 * np.array(START_HALF_WIDTH[:p]), lo, hi)) if n_starts > 1 else [q0]
+    cant = None
+    if prof is not None:
+        cant = _cantilever_start(prof, areal_mass, profile_kwargs, pn, p, lo, hi)
+        report("cantilever", q0, best["loss"])
+        cands.append(np.asarray(cant["q"], float))
     runs.evaluate(cands)
     starts = [(c, loss(c, "global")) for c in cands]
-    x0 = np.clip(min(starts, key=lambda t: t[1])[0], lo + 1e-9, hi - 1e-9)
-    # (4) the gradient phase
-    if mode == "ad":
-        opt = minimize(lambda q: (loss(q), grad_ad(q)), x0, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
-                       options={"maxfun": int(max_iter)})
-        opt.ok = bool(opt.success)
-    else:
-        opt = least_squares(rows, x0, jac=fd_jac, bounds=(lo, hi), method="trf", max_nfev=int(max_iter), x_scale=1.0,
-                            ftol=1e-3, xtol=1e-3, gtol=1e-8)
-        opt.ok = bool(opt.status > 0)
-    # (5) the best law seen; where the probes of its final Jacobian fit better still (the optimiser
-    # stopped on a rough wall), move to the best probe and probe again, at most max_iter moves
-    q, moves = np.asarray(best["q"], float), 0
-    J = fd_jac(q)
-    while best["loss"] < (1.0 - MOVE_RTOL) * loss(q) and moves < int(max_iter):
-        q, moves = np.asarray(best["q"], float), moves + 1
+
+    # (4) the gradient phase and (5) the probe moves, from one start
+    def local(x0):
+        x0 = np.clip(x0, lo + 1e-9, hi - 1e-9)
+        here.update(loss=math.inf, q=x0)
+        if mode == "ad":
+            opt = minimize(lambda q: (loss(q), grad_ad(q)), x0, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)),
+                           options={"maxfun": int(max_iter)})
+            opt.ok = bool(opt.success)
+        else:
+            opt = least_squares(rows, x0, jac=fd_jac, bounds=(lo, hi), method="trf", max_nfev=int(max_iter), x_scale=1.0,
+                                ftol=1e-3, xtol=1e-3, gtol=1e-8)
+            opt.ok = bool(opt.status > 0)
+        # the best law seen; where the probes of its final Jacobian fit better still (the optimiser
+        # stopped on a rough wall), move to the best probe and probe again, at most max_iter moves
+        q, moves = np.asarray(here["q"], float), 0
         J = fd_jac(q)
-    r = rows(q)
-    opt.moves = moves
+        while here["loss"] < (1.0 - MOVE_RTOL) * loss(q) and moves < int(max_iter):
+            q, moves = np.asarray(here["q"], float), moves + 1
+            J = fd_jac(q)
+        r = rows(q)
+        opt.moves = moves
+        return q, r, J, opt, misfit(float(r @ r), *moments)
+
+    # (6) from the next-best starts while the result is a local minimum (fails the misfit test)
+    order = sorted(range(len(starts)), key=lambda i: starts[i][1])
+    fits, chosen = [], None
+    for i in order:
+        if len(fits) > int(restarts) or not math.isfinite(starts[i][1]) or (chosen and chosen[4]["consistent"]):
+            break
+        if any(np.max(np.abs(starts[i][0] - f["q_final"])) < fd_step for f in fits):
+            continue  # where an earlier local fit ended: it would end there again
+        out = local(starts[i][0])
+        fits.append({"start": i, "q_start": list(map(float, starts[i][0])), "loss_start": starts[i][1],
+                     "q_final": np.asarray(out[0], float), "loss_final": 0.5 * float(out[1] @ out[1]),
+                     "misfit_p": out[4]["p_value"], "forming_runs": runs.runs})
+        if chosen is None or fits[-1]["loss_final"] < 0.5 * float(chosen[1] @ chosen[1]):
+            chosen = out
+    q, r, J, opt, _ = chosen
+    local_fits = [dict(f, q_final=list(map(float, f["q_final"]))) for f in fits]
     return _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi,
-                      starts, q0, time.perf_counter() - t0, rows, moments)
+                      starts, q0, time.perf_counter() - t0, rows, moments, local_fits, cant)
+
+
+def _cantilever_start(prof, areal_mass, profile_kwargs, noise, p, lo, hi) -> dict:
+    """The law the cantilever profiles alone give (:func:`~jaxform.calibrate.fit_cantilever`, the
+    same model and noise as the joint residual), as a start of the global phase (clipped to its
+    bounds): the profiles pin B_init and M at their curvatures without a forming run."""
+    from jaxform.calibrate.cantilever_fit import fit_cantilever
+
+    t0 = time.perf_counter()
+    cf = fit_cantilever(prof.profiles, areal_mass=areal_mass, simulate_kwargs=dict(profile_kwargs or {}), noise=noise)
+    q = np.clip(np.append(q_from_law(cf.law, "voce"), [0.0] * (p - 3)), lo, hi)
+    law = cf.law
+    return {"b_inf_Nm": float(law.b_inf), "m0_N": float(law.m0), "kappa0_per_m": float(law.kappa0),
+            "b_init_Nm": float(law.b_init), "converged": bool(cf.converged), "q": list(map(float, q)),
+            "wall_time_s": time.perf_counter() - t0}
 
 
 def _n_prof(prof) -> int:
@@ -345,7 +398,7 @@ def _n_prof(prof) -> int:
 
 
 def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi, starts, q0,
-               wall, rows, moments) -> WrinkleFit:
+               wall, rows, moments, local_fits, cant) -> WrinkleFit:
     p = len(q)
     y, valid, ok, reach = runs.evaluate([q])[0]
     y0 = runs.evaluate([q0])[0][0]
@@ -396,8 +449,8 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
         reasons.append(f"the fit misses the data by more than the noise explains (chi-square {chi2:.4g} where the "
                        f"true law would leave {fit_misfit['expected']:.4g} +- {fit_misfit['sd']:.3g}; p = "
                        f"{fit_misfit['p_value']:.2g}, limit {fit_misfit['limit']:g}): a local minimum of the rough loss "
-                       "(a better law may exist; the standard deviations describe this minimum only), a law of another "
-                       "form, or more noise than given")
+                       f"after {len(local_fits)} local fit(s) from the best starts (a better law may exist; the standard "
+                       "deviations describe this minimum only), a law of another form, or more noise than given")
     return WrinkleFit(
         law=law_from_q(jnp.asarray(q[:3], dtype), "voce"), law_initial=runs.law0, shear_scale=shear, q=q, values=values, sigma=sigma,
         determined=determined, loss_initial=loss0, loss_final=loss, rms_per_section=rms, rms_initial_per_section=rms0,
@@ -407,7 +460,7 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
         moves=opt.moves, forming_runs=runs.runs,
         wall_time=wall, converged=converged and not reasons, reason="; ".join(reasons),
         starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov,
-        sigma_check=sigma_check, misfit=fit_misfit)
+        sigma_check=sigma_check, misfit=fit_misfit, local_fits=local_fits, cantilever_start=cant)
 
 
 __all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "predict_sections", "sections_of", "section_loss", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",

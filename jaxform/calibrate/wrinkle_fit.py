@@ -71,7 +71,7 @@ from scipy.stats.qmc import LatinHypercube
 from jaxform import cantilever
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
-from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel
+from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel, fit_cantilever
 from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, sections_of
 from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
@@ -382,12 +382,10 @@ def _cantilever_start(prof, areal_mass, profile_kwargs, noise, p, lo, hi) -> dic
     """The law the cantilever profiles alone give (:func:`~jaxform.calibrate.fit_cantilever`, the
     same model and noise as the joint residual), as a start of the global phase (clipped to its
     bounds): the profiles pin B_init and M at their curvatures without a forming run."""
-    from jaxform.calibrate.cantilever_fit import fit_cantilever
-
     t0 = time.perf_counter()
     cf = fit_cantilever(prof.profiles, areal_mass=areal_mass, simulate_kwargs=dict(profile_kwargs or {}), noise=noise)
-    q = np.clip(np.append(q_from_law(cf.law, "voce"), [0.0] * (p - 3)), lo, hi)
     law = cf.law
+    q = np.clip(np.append(q_from_law(law, "voce"), [0.0] * (p - 3)), lo, hi)
     return {"b_inf_Nm": float(law.b_inf), "m0_N": float(law.m0), "kappa0_per_m": float(law.kappa0),
             "b_init_Nm": float(law.b_init), "converged": bool(cf.converged), "q": list(map(float, q)),
             "wall_time_s": time.perf_counter() - t0}

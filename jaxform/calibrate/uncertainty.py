@@ -105,7 +105,6 @@ def _json(v):
     return float(v) if math.isfinite(v) else None
 
 
-
 def misfit(chi2: float, mean: float, var: float) -> dict:
     """How likely the measurement noise alone leaves a chi-square of at least ``chi2`` at the true
     law, where the rows' chi-square has mean ``mean`` and variance ``var`` there (correlated rows:

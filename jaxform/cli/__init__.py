@@ -39,8 +39,22 @@ TERMINATED = "terminated by SIGTERM"
 """The reason a run stopped by ``kill`` or a scheduler records (the command exits 143)."""
 
 
+_STOP: list[str] = []
+"""Set by :func:`_terminate`. Python runs a signal handler at any bytecode, and where that is inside
+a hook that ignores exceptions (JAX's garbage-collection callback, seen on a 4 mm run) its
+``KeyboardInterrupt`` is lost and the run went on; :func:`raise_if_stopped` raises it again at the
+next chunk (the progress callback calls it)."""
+
+
 def _terminate(signum, frame):
+    _STOP.append(TERMINATED)
     raise KeyboardInterrupt(TERMINATED)
+
+
+def raise_if_stopped() -> None:
+    """Raise the ``KeyboardInterrupt`` of a SIGTERM already received (one a hook swallowed)."""
+    if _STOP:
+        raise KeyboardInterrupt(_STOP[0])
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -50,6 +64,7 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     # SIGTERM (kill, a scheduler) stops a run like Ctrl-C does: what was written stays valid and says why
+    _STOP.clear()
     previous = signal.signal(signal.SIGTERM, _terminate) if threading.current_thread() is threading.main_thread() else None
     try:
         return int(args.handler(args) or 0)

@@ -7,6 +7,8 @@ import time
 
 from tqdm import tqdm
 
+from jaxform.cli import raise_if_stopped
+
 
 class Progress:
     """``on_progress(step, n_steps, t, punch_displacement_m, elapsed_s)`` callback of
@@ -41,6 +43,7 @@ class Progress:
             print(msg, file=self.stream, flush=True)
 
     def __call__(self, step, n_steps, t, disp, elapsed):
+        raise_if_stopped()  # a SIGTERM whose exception a hook swallowed stops the run here, at a chunk's end
         if self.quiet:
             return
         if self.n_steps is None:

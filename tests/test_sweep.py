@@ -88,6 +88,26 @@ def test_members_share_a_step_count_and_split_into_groups_and_parts():
         batch.member_cases(fast, ["contact.friction=0.2"])
 
 
+def test_lbm_and_nlbm_members_share_a_program_and_the_lbm_one_equals_its_own_run():
+    import jax.numpy as jnp
+
+    from jaxform.materials import LinearBending, VoceBending
+
+    lbm = _case('fabric.bending="lbm-41"')
+    rigs, groups = batch.build_members([_case(), lbm, _case("fabric.bending=membrane")])
+    assert groups == [[0, 1], [2]]  # the linear law joins the Voce member; membrane-only runs apart
+    law, own = rigs[1].model.shell.fabrics[0].bending[0], forming.build(lbm).model.shell.fabrics[0].bending[0]
+    b = own.b
+    assert isinstance(own, LinearBending) and isinstance(law, VoceBending) and float(law.m0) == 0.0 and float(law.b_inf) == pytest.approx(float(b))
+    kappa = jnp.array([-300.0, -1.0, 0.0, 2.0, 250.0])
+    for f in ("moment", "stiffness", "energy"):
+        assert np.array_equal(getattr(law, f)(kappa), getattr(LinearBending(b), f)(kappa))
+    res = batch.simulate_batch(_case(), [[], ['fabric.bending="lbm-41"']])
+    single = forming.simulate(lbm)
+    assert res[1].summary["batch"]["members"] == 2 and res[1].complete and single.complete
+    assert np.max(np.abs(np.asarray(res[1].x[-1]) - np.asarray(single.x[-1]))) < 1e-6  # m
+
+
 def test_sweep_writes_each_member_like_a_run_and_a_table(swept):
     code, out, rows = swept
     assert code == 1  # members failed: the command says so

@@ -9,7 +9,8 @@ How members share a program:
 
 * **Groups.** Members whose rigs have the same structure (the pytree of model and state with its
   static fields, every array's shape and dtype: the mesh, plies, bending-law type, fibre-mass factor,
-  self-contact tables) and the same frames run together. Members that cannot share a program are
+  self-contact tables) and the same frames run together; a linear bending law joins Voce members
+  as the Voce law with ``m0 = 0`` (:func:`common_form`). Members that cannot share a program are
   grouped by that structure and run group after group.
 * **A common step count.** Members of different speeds (or different stable steps) take the
   largest step count of their group: each member's step becomes its stroke time over that count
@@ -61,6 +62,7 @@ from jaxform.forming.fields import SCALARS, state_fields
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, build
 from jaxform.forming.summary import summarize
+from jaxform.materials import Fabric, LinearBending, VoceBending
 
 INTERRUPTED = "interrupted (KeyboardInterrupt)"
 """The start of the reason of members stopped by Ctrl-C or SIGTERM (their batch runs no further part)."""
@@ -109,6 +111,40 @@ def member_cases(case: Case, overrides_per_member: Sequence, *, element_size: fl
     return out
 
 
+BATCH_FABRIC_NAME = "batch member"
+"""The fabric's static label inside a batched program (:func:`common_form`); summaries name the case."""
+
+
+def _to_voce(law):
+    if isinstance(law, LinearBending):
+        return VoceBending(b_inf=law.b, m0=law.b * 0.0, kappa0=law.b * 0.0 + 1.0)  # b's type: float or array
+    return law
+
+
+def common_form(rigs: Sequence) -> list:
+    """The rigs with what a batch need not tell apart made one, so that more members share a
+    program: the fabric's name (a static label, used by nothing in the run) and, where some member
+    bends by a Voce law, a linear law ``M = b kappa`` written as the Voce law ``b_inf = b, m0 = 0``
+    (the same moment, stiffness and energy; its numerics were chosen from the linear law, with the
+    same ``B_init``). So a fabric's NLBM and LBM members of one mesh (the paper study's four bending
+    laws) run as one program; a membrane-only member (no bending) still runs apart. Exceptions
+    (members whose rig could not be built) pass through."""
+    is_law = lambda x: isinstance(x, (LinearBending, VoceBending))  # noqa: E731
+    voce = any(isinstance(x, VoceBending) for r in rigs if not isinstance(r, Exception)
+               for x in jax.tree_util.tree_leaves(r.model, is_leaf=is_law))
+
+    def fabric(f):
+        if not isinstance(f, Fabric):
+            return f
+        bending = f.bending if f.bending is None or not voce else \
+            jax.tree_util.tree_map(_to_voce, f.bending, is_leaf=is_law)
+        return f.replace(name=BATCH_FABRIC_NAME, bending=bending)
+
+    return [r if isinstance(r, Exception) else
+            r._replace(model=jax.tree_util.tree_map(fabric, r.model, is_leaf=lambda x: isinstance(x, Fabric)))
+            for r in rigs]
+
+
 def signature(rig: Rig):
     """What members must share to run as one program: the structure and leaf shapes/dtypes of
     model and state (static fields included) and the frames and chunks of the run."""
@@ -131,6 +167,7 @@ def build_members(cases: Sequence[Case], *, dtype=None, samples_per_frame: int |
             if not catch:
                 raise
             rigs.append(err)
+    rigs = common_form(rigs)
     keys, groups = [], []
     for i, r in enumerate(rigs):
         if isinstance(r, Exception):
@@ -147,7 +184,8 @@ def build_members(cases: Sequence[Case], *, dtype=None, samples_per_frame: int |
         every = max(rigs[i].info.every for i in g)
         for i in g:
             if rigs[i].info.every != every:
-                rigs[i] = build(cases[i], dtype=dtype, samples_per_frame=samples_per_frame, every=every)
+                rigs[i] = common_form([build(cases[i], dtype=dtype, samples_per_frame=samples_per_frame,
+                                             every=every), rigs[i]])[0]  # rigs[i]: Voce where the batch is
     return rigs, groups
 
 
@@ -484,6 +522,6 @@ def simulate_batch(case: Case, overrides_per_member: Sequence, *, element_size: 
             for c, r in zip(cases, results)]
 
 
-__all__ = ["INTERRUPTED", "MESH_AXIS", "MEMORY_PER_ARRAY_BYTE", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "not_run", "member_bytes",
+__all__ = ["INTERRUPTED", "MESH_AXIS", "BATCH_FABRIC_NAME", "common_form", "MEMORY_PER_ARRAY_BYTE", "MEMORY_FRACTION", "BatchPart", "member_cases", "signature", "build_members", "not_run", "member_bytes",
            "plan_parts",
            "run_part", "simulate_batch"]

@@ -4,7 +4,8 @@ whether a run already in the study's folder can be reused.
 The study runs, for both fabrics, Case A with NLBM, LBM (B_init, B_41.5, B_inf) and membrane only,
 and Case B with NLBM: the twelve presets of :mod:`jaxform.forming.presets`, each in the folder
 ``DIR/runs/<preset>/``. Runs of one fabric's Case A are batched (they share the mesh;
-:func:`jaxform.forming.batch.simulate_batch` groups them by program structure).
+:func:`jaxform.forming.batch.simulate_batch` groups them by program structure: the four bending laws as
+one program, the linear ones written as Voce laws with ``m0 = 0``; membrane-only apart).
 """
 from __future__ import annotations
 

@@ -24,7 +24,7 @@ step (woven Case A in float64: about 1e277 against central differences of 1e6 at
 fit (1) checks at the start the AD gradient of the actual loss against central differences with
 its step ``fd_step`` (0.05 in log space) and records both, (2) uses the AD Jacobian only where
 they agree within :data:`GRAD_RTOL` (else forward differences with ``fd_step``, said in
-``gradient_check``), (3) scores the starting law, a
+``gradient_check``; the profiles' rows exactly, by the cantilever's own AD), (3) scores the starting law, a
 seeded Latin hypercube around it (box :data:`START_HALF_WIDTH`, one run each) and, with profiles,
 the law the cantilever profiles alone give (:func:`~jaxform.calibrate.fit_cantilever`, no forming
 run: on the joint benchmark it is within 2.5 % in B_init where the joint fit from the best
@@ -289,7 +289,10 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         pts = [q + h * e for h, e in zip(steps, np.eye(p))]
         runs.evaluate([q] + pts)  # one batch
         r0 = rows(q)
-        return np.stack([(rows(x) - r0) / h for x, h in zip(pts, steps)], axis=1)
+        J = np.stack([(rows(x) - r0) / h for x, h in zip(pts, steps)], axis=1)
+        if prof is not None:  # the profiles' rows exactly (the cantilever's own AD), not a secant over fd_step
+            J[R.shape[0]:] = np.pad(prof_jac(q), ((0, 0), (0, p - 3)))
+        return J
 
     # the starting law: the case's rig must produce every section
     ev0 = runs.evaluate([q0])[0]

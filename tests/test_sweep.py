@@ -102,6 +102,7 @@ def test_lbm_and_nlbm_members_share_a_program_and_the_lbm_one_equals_its_own_run
     kappa = jnp.array([-300.0, -1.0, 0.0, 2.0, 250.0])
     for f in ("moment", "stiffness", "energy"):
         assert np.array_equal(getattr(law, f)(kappa), getattr(LinearBending(b), f)(kappa))
+        assert np.array_equal(getattr(LinearBending(2.2e-4).as_voce(), f)(kappa), getattr(LinearBending(2.2e-4), f)(kappa))
     res = batch.simulate_batch(_case(), [[], ['fabric.bending="lbm-41"']])
     single = forming.simulate(lbm)
     assert res[1].summary["batch"]["members"] == 2 and res[1].complete and single.complete

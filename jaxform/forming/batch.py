@@ -115,12 +115,6 @@ BATCH_FABRIC_NAME = "batch member"
 """The fabric's static label inside a batched program (:func:`common_form`); summaries name the case."""
 
 
-def _to_voce(law):
-    if isinstance(law, LinearBending):
-        return VoceBending(b_inf=law.b, m0=law.b * 0.0, kappa0=law.b * 0.0 + 1.0)  # b's type: float or array
-    return law
-
-
 def common_form(rigs: Sequence) -> list:
     """The rigs with what a batch need not tell apart made one, so that more members share a
     program: the fabric's name (a static label, used by nothing in the run) and, where some member
@@ -136,8 +130,8 @@ def common_form(rigs: Sequence) -> list:
     def fabric(f):
         if not isinstance(f, Fabric):
             return f
-        bending = f.bending if f.bending is None or not voce else \
-            jax.tree_util.tree_map(_to_voce, f.bending, is_leaf=is_law)
+        as_voce = lambda b: b.as_voce() if isinstance(b, LinearBending) else b  # noqa: E731
+        bending = f.bending if f.bending is None or not voce else jax.tree_util.tree_map(as_voce, f.bending, is_leaf=is_law)
         return f.replace(name=BATCH_FABRIC_NAME, bending=bending)
 
     return [r if isinstance(r, Exception) else

@@ -73,6 +73,11 @@ class LinearBending:
         """Stiffness at large curvature, N·m."""
         return self.b
 
+    def as_voce(self) -> "VoceBending":
+        """The same law as a :class:`VoceBending` (``b_inf = b``, ``m0 = 0``): the same moment,
+        stiffness and energy; ``m0`` and ``kappa0`` of ``b``'s type (float or array)."""
+        return VoceBending(b_inf=self.b, m0=self.b * 0.0, kappa0=self.b * 0.0 + 1.0)
+
 
 @pytree_dataclass
 class VoceBending:

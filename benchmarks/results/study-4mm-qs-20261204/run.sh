@@ -1,0 +1,7 @@
+# How this record was made (run from the repository root, both cores): the study's woven part, then Case B woven as its own run with the study's overrides into the same folder, then `jaxform study paper --out DIR --element-size-mm 4 --analyse-only` (the standard-test cache copied in from the GPU record).
+cd /work/main
+start=$(date +%s)
+.venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --only case-a-woven > .git/study/qs4-woven.log 2>&1
+echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-woven.log
+.venv/bin/jaxform run case-b-woven-nlbm --out .git/study/qs4/runs/case-b-woven-nlbm --set 'name="case-b-woven-nlbm"' --set numerics.fibre_mass_scaling=auto --set blank.element_size_mm=4.0 > .git/study/qs4-bwoven.log 2>&1
+echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-bwoven.log

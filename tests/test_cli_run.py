@@ -232,6 +232,7 @@ def test_a_sigterm_whose_exception_a_hook_swallowed_still_stops_the_run(tmp_out,
     s = json.loads((tmp_out / "summary.json").read_text())
     assert s["complete"] is False and s["reason"] == "terminated by SIGTERM"
     assert s["numerics"]["steps_done"] == sent[0] < s["numerics"]["n_steps"]
+    original(run_mod.Progress(quiet=True), 1, 10, 0.0, 0.0, 0.0)  # the next run in this process is not stopped
 
 
 def test_a_run_that_leaves_its_physical_bounds_stops_and_says_why(tmp_out):

@@ -75,6 +75,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"jaxform {args.command}: {err or 'interrupted'}", file=sys.stderr)
         return 143 if str(err) == TERMINATED else 130
     finally:
+        _STOP.clear()  # a later run in this process (tests, notebooks) starts unstopped
         if previous is not None:
             signal.signal(signal.SIGTERM, previous)
 

@@ -23,7 +23,7 @@ widened where it rises less: ``sigma_check``; ``null`` where no finite sd exists
 ``loss_final``, ``rms_mm_per_section`` and ``nrmse_per_section`` (the paper's metric),
 ``gradient_check`` (AD vs central differences at the start and what the fit did about it),
 ``iterations``, ``forming_runs``, ``wall_time_s``, ``misfit`` (the chi-square against what the noise
-leaves at the true law), ``local_fits`` (each local fit: its start, final loss and misfit p; more than
+leaves at the true law, as a whole and per block of data: ``blocks``, ``failed``), ``local_fits`` (each local fit: its start, final loss and misfit p; more than
 one where the first ended in a local minimum), ``cantilever_start`` (with profiles: the law they give
 alone, one of the starts), ``converged`` and ``reason``. An existing --out
 is never overwritten without --force.

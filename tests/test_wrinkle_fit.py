@@ -224,6 +224,60 @@ def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypat
     assert fit.as_dict()["local_fits"][-1]["loss_final"] == pytest.approx(fit.loss_final)
 
 
+def test_the_optimiser_s_trial_runs_beside_its_difference_laws_in_idle_slots(monkeypatch):
+    """With two workers (a CPU's two cores) the optimiser's trial law runs beside one of its
+    forward-difference laws: an accepted trial's Jacobian then needs one round of runs, not two.
+    The same fit, the same laws; fewer rounds (the stub of the moves test: linear, no forming run)."""
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
+    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
+                  end=np.array([0.09, 0.0]))
+    q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
+    shape = np.stack([np.ones(31), np.linspace(-1.0, 1.0, 31), np.zeros(31)], 1)
+
+    def stub(Q, Z, rig, lines, static):
+        y = 1e-3 * (np.asarray(Q, float) - q_true) @ shape.T
+        return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
+
+    monkeypatch.setattr(section_runs, "_batch", stub)
+    evaluate, rounds = section_runs.SectionRuns.evaluate, []
+
+    def counted(self, qs):
+        todo = len({section_runs._key(q) for q in qs if not self.cached(q)})
+        rounds.append(-(-todo // 2))  # two workers
+        return evaluate(self, qs)
+
+    monkeypatch.setattr(section_runs.SectionRuns, "evaluate", counted)
+    kw = dict(n_starts=1, max_iter=4, gradient_check=False, workers=2)
+    fit = wf.fit_wrinkles(case, [sec], **kw)
+    with_spare = sum(rounds)
+    rounds.clear()
+    monkeypatch.setattr(section_runs.SectionRuns, "round_laws", property(lambda self: 1))  # no spare slot used
+    plain = wf.fit_wrinkles(case, [sec], **kw)
+    assert np.allclose(fit.q, plain.q) and fit.loss_final == pytest.approx(plain.loss_final)
+    assert with_spare < sum(rounds), (with_spare, sum(rounds))
+
+
+def test_block_misfit_flags_a_block_that_the_whole_test_hides():
+    """jaxform.calibrate.uncertainty.block_misfit on the joint fit's figures at a 0.0125 log step
+    (record 20261204T-qs-joint-step.json): chi-square 401 against 205 +- 75 passes as a whole
+    (p = 0.014), while its profile (0.0805 mm RMS on 60 rows, 0.05 mm noise: 156) fails on its own;
+    rows drawn from the noise pass; one block is the plain misfit test."""
+    from jaxform.calibrate.uncertainty import block_misfit, misfit
+
+    sec_var = 74.67194314409132**2 - 120.0
+    r = np.concatenate([np.full(145, math.sqrt((401.47 - 155.5) / 145)), np.full(60, 0.0805 / 0.05)])
+    blocks = [("sections", slice(0, 145), 145.0, sec_var), ("profiles", slice(145, None), 60.0, 120.0)]
+    out = block_misfit(r, blocks)
+    assert out["p_value"] == pytest.approx(0.014, abs=0.002) and out["p_value"] > MISFIT_P
+    assert out["failed"] == ["profiles"] and not out["consistent"]
+    assert out["blocks"]["profiles"]["p_value"] < 1e-8 and out["blocks"]["sections"]["consistent"]
+    assert out["blocks"]["profiles"]["limit"] == pytest.approx(MISFIT_P / 2)
+    noise = np.random.default_rng(1).standard_normal(205)
+    assert block_misfit(noise, [("a", slice(0, 145), 145.0, 290.0), ("b", slice(145, None), 60.0, 120.0)])["consistent"]
+    one = block_misfit(r, [("all", slice(None), 205.0, 74.67194314409132**2)])
+    assert one["consistent"] == misfit(float(r @ r), 205.0, 74.67194314409132**2)["consistent"] and one["failed"] == []
+
+
 def _cli(argv, capsys):
     return run_calibration_script("fit_wrinkles", argv, capsys)
 

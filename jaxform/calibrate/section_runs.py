@@ -118,6 +118,15 @@ class SectionRuns:
         self.cache: dict = {}
         self.runs = 0
 
+    @property
+    def round_laws(self) -> int:
+        """Laws that one round of runs holds (``workers`` batches of ``width`` members at once, ``seeds``
+        members a law): evaluating fewer leaves slots idle."""
+        return max(1, self.workers * self.width // self.seeds)
+
+    def cached(self, q) -> bool:
+        return _key(q) in self.cache
+
     def evaluate(self, qs: Sequence[np.ndarray]) -> list:
         """``(y (M,), valid (M,), ok, kappa_reach)`` per ``q``, the mean over the seeds (host)."""
         keys = [_key(q) for q in qs]

@@ -120,4 +120,28 @@ def misfit(chi2: float, mean: float, var: float) -> dict:
             "limit": MISFIT_P, "consistent": p >= MISFIT_P}
 
 
-__all__ = ["PROBE_SDS", "MISFIT_P", "MIN_RATIO", "checked_covariance", "misfit"]
+def block_misfit(r, blocks: Sequence[tuple]) -> dict:
+    """:func:`misfit` of the residual rows ``r`` as a whole and of each block of data apart.
+
+    ``blocks``: ``(name, rows, mean, var)`` per block (``rows`` a slice or index array into ``r``;
+    ``mean``, ``var`` its chi-square's moments at the true law). A joint fit can pass the test as a
+    whole while one block fails it: the sections' loss, rough and of many rows, can buy a better fit
+    with a law that a few dozen cantilever rows reject (the joint wrinkle fit at 62.5 mm/s with a
+    0.0125 log step: chi-square 401 against 205 +- 75, p = 0.014, while its profile, 0.081 mm RMS
+    against 0.05 mm noise, is 156 on 60 rows, p ~ 1e-10; its B_init was 5.8 % off). The whole is
+    consistent where its own test passes at :data:`MISFIT_P` and every block's at ``MISFIT_P / n``
+    with ``n`` blocks (Bonferroni: at the true law the test as a whole still fails with at most twice
+    :data:`MISFIT_P`). Returns :func:`misfit`'s dict for the whole with ``blocks`` (each block's)
+    and ``failed`` (the names of the blocks that fail)."""
+    r = np.asarray(r, float)
+    out = misfit(float(r @ r), sum(b[2] for b in blocks), sum(b[3] for b in blocks))
+    lim = MISFIT_P / len(blocks)
+    each = {}
+    for name, rows, mean, var in blocks:
+        m = misfit(float(np.sum(r[rows] ** 2)), mean, var)
+        each[name] = dict(m, limit=lim, consistent=m["p_value"] >= lim)
+    failed = [k for k, m in each.items() if not m["consistent"]] if len(blocks) > 1 else []
+    return dict(out, consistent=out["consistent"] and not failed, blocks=each, failed=failed)
+
+
+__all__ = ["PROBE_SDS", "MISFIT_P", "MIN_RATIO", "checked_covariance", "misfit", "block_misfit"]

@@ -400,8 +400,11 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         out = local(starts[i][0])
         fits.append({"start": i, "q_start": list(map(float, starts[i][0])), "loss_start": starts[i][1],
                      "q_final": np.asarray(out[0], float), "loss_final": 0.5 * float(out[1] @ out[1]),
-                     "misfit_p": out[4]["p_value"], "forming_runs": runs.runs})
-        if chosen is None or fits[-1]["loss_final"] < 0.5 * float(chosen[1] @ chosen[1]):
+                     "misfit_p": out[4]["p_value"], "misfit_failed": out[4]["failed"], "forming_runs": runs.runs})
+        # the best: consistent with the data before inconsistent (a joint fit's lower loss can hide a
+        # block it misses), then the lower loss
+        if chosen is None or (out[4]["consistent"], -fits[-1]["loss_final"]) > (chosen[4]["consistent"],
+                                                                                -0.5 * float(chosen[1] @ chosen[1])):
             chosen = out
     q, r, J, opt, _ = chosen
     local_fits = [dict(f, q_final=list(map(float, f["q_final"]))) for f in fits]

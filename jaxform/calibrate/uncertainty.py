@@ -128,7 +128,7 @@ def block_misfit(r, blocks: Sequence[tuple]) -> dict:
     whole while one block fails it: the sections' loss, rough and of many rows, can buy a better fit
     with a law that a few dozen cantilever rows reject (the joint wrinkle fit at 62.5 mm/s with a
     0.0125 log step: chi-square 401 against 205 +- 75, p = 0.014, while its profile, 0.081 mm RMS
-    against 0.05 mm noise, is 156 on 60 rows, p ~ 1e-10; its B_init was 5.8 % off). The whole is
+    against 0.05 mm noise, is 156 on 60 rows, p = 2e-10; its B_init was 5.8 % off). The whole is
     consistent where its own test passes at :data:`MISFIT_P` and every block's at ``MISFIT_P / n``
     with ``n`` blocks (Bonferroni: at the true law the test as a whole still fails with at most twice
     :data:`MISFIT_P`). Returns :func:`misfit`'s dict for the whole with ``blocks`` (each block's)

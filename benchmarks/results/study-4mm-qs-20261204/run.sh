@@ -5,3 +5,9 @@ start=$(date +%s)
 echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-woven.log
 .venv/bin/jaxform run case-b-woven-nlbm --out .git/study/qs4/runs/case-b-woven-nlbm --set 'name="case-b-woven-nlbm"' --set numerics.fibre_mass_scaling=auto --set blank.element_size_mm=4.0 > .git/study/qs4-bwoven.log 2>&1
 echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-bwoven.log
+# Added on 2026-12-04 (next session, at 7d0bd28): the NCF Case A bending laws (the four in one program; membrane-only and
+# Case B NCF not run), then the report again over every run in the folder.
+start=$(date +%s)
+.venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --only case-a-ncf --bending nlbm,lbm-init,lbm-41,lbm-inf > .git/study/qs4-ncf.log 2>&1
+echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-ncf.log
+.venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --analyse-only > .git/study/qs4-analyse2.log 2>&1

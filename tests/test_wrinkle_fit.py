@@ -166,14 +166,18 @@ def test_a_fit_run_that_fails_without_the_momentum_term_is_run_again_with_it(mon
     assert runs.runs == 2 + width  # both laws, and the failed one's batch again with the term
 
 
-def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):
-    """Where the optimiser stops (here: out of evaluations) and a probe of the final Jacobian fits
-    better, the fit moves there and probes again, and reports the best law it saw. The forming
-    program is stubbed by amplitudes linear in the law (the truth 0.3 up in log B_init and log
-    kappa0), so this runs no forming run."""
+def _stub_case():
+    """A coarse woven Case A and one radial section on it, for fits whose forming program is stubbed."""
     case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
     sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
                   end=np.array([0.09, 0.0]))
+    return case, sec
+
+
+def _linear_stub(monkeypatch):
+    """:func:`_stub_case` with the forming program stubbed by amplitudes linear in the law (the truth
+    0.3 up in log B_init and log kappa0 from the preset's): no forming run."""
+    case, sec = _stub_case()
     q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
     shape = np.stack([np.ones(31), np.linspace(-1.0, 1.0, 31), np.zeros(31)], 1)
 
@@ -182,6 +186,15 @@ def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):
         return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
 
     monkeypatch.setattr(section_runs, "_batch", stub)
+    return case, sec
+
+
+def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):
+    """Where the optimiser stops (here: out of evaluations) and a probe of the final Jacobian fits
+    better, the fit moves there and probes again, and reports the best law it saw. The forming
+    program is stubbed by amplitudes linear in the law (the truth 0.3 up in log B_init and log
+    kappa0), so this runs no forming run."""
+    case, sec = _linear_stub(monkeypatch)
     fit = wf.fit_wrinkles(case, [sec], n_starts=1, max_iter=1, gradient_check=False)  # no optimiser step
     assert fit.moves == 1  # one 0.05 log step downhill, the most max_iter allows
     seen = wf.section_loss(case, [sec], [fit.q])[0][0]
@@ -196,9 +209,7 @@ def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypat
     B_init, h(u) = u^3 - 3u + 2.5 with u = u* + 4 (q0 - q0_true) (u* its real root), whose square
     has a local minimum at u = 1 (h = 0.5, ten noise sds a row) and the zero at the truth, plus
     terms linear in the other two parameters; the starting law sits at u = 0, downhill of the trap."""
-    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
-    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
-                  end=np.array([0.09, 0.0]))
+    case, sec = _stub_case()
     u_root = float(np.real(np.roots([1.0, 0.0, -3.0, 2.5])[np.isreal(np.roots([1.0, 0.0, -3.0, 2.5]))][0]))
     q_start = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce")
     q_true = q_start + [u_root / 4.0, -0.2, 0.2]
@@ -228,17 +239,7 @@ def test_the_optimiser_s_trial_runs_beside_its_difference_laws_in_idle_slots(mon
     """With two workers (a CPU's two cores) the optimiser's trial law runs beside one of its
     forward-difference laws: an accepted trial's Jacobian then needs one round of runs, not two.
     The same fit, the same laws; fewer rounds (the stub of the moves test: linear, no forming run)."""
-    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3, overrides=["numerics.fibre_mass_scaling=12"])
-    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
-                  end=np.array([0.09, 0.0]))
-    q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
-    shape = np.stack([np.ones(31), np.linspace(-1.0, 1.0, 31), np.zeros(31)], 1)
-
-    def stub(Q, Z, rig, lines, static):
-        y = 1e-3 * (np.asarray(Q, float) - q_true) @ shape.T
-        return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
-
-    monkeypatch.setattr(section_runs, "_batch", stub)
+    case, sec = _linear_stub(monkeypatch)
     evaluate, rounds = section_runs.SectionRuns.evaluate, []
 
     def counted(self, qs):
@@ -276,6 +277,7 @@ def test_block_misfit_flags_a_block_that_the_whole_test_hides():
     assert block_misfit(noise, [("a", slice(0, 145), 145.0, 290.0), ("b", slice(145, None), 60.0, 120.0)])["consistent"]
     one = block_misfit(r, [("all", slice(None), 205.0, 74.67194314409132**2)])
     assert one["consistent"] == misfit(float(r @ r), 205.0, 74.67194314409132**2)["consistent"] and one["failed"] == []
+    assert block_misfit(3.0 * r, [("all", slice(None), 205.0, 74.67194314409132**2)])["failed"] == ["all"]
 
 
 def _cli(argv, capsys):

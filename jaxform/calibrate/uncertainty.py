@@ -140,7 +140,7 @@ def block_misfit(r, blocks: Sequence[tuple]) -> dict:
     for name, rows, mean, var in blocks:
         m = misfit(float(np.sum(r[rows] ** 2)), mean, var)
         each[name] = dict(m, limit=lim, consistent=m["p_value"] >= lim)
-    failed = [k for k, m in each.items() if not m["consistent"]] if len(blocks) > 1 else []
+    failed = [k for k, m in each.items() if not m["consistent"]]
     return dict(out, consistent=out["consistent"] and not failed, blocks=each, failed=failed)
 
 

@@ -350,7 +350,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         cant = _cantilever_start(prof, areal_mass, profile_kwargs, pn, p, lo, hi)
         report("cantilever", q0, best["loss"])
         centre = np.asarray(cant["q"], float)
-        half[0] = min(half[0], max(CANTILEVER_SDS * cant["sd_q"][0], fd_step))
+        if math.isfinite(cant["sd_q"][0]):  # else (B_init undetermined by the profiles) the usual width
+            half[0] = min(half[0], max(CANTILEVER_SDS * cant["sd_q"][0], fd_step))
         cands.append(centre)
     if n_starts > 1:
         cands += list(np.clip(centre + (2.0 * LatinHypercube(d=p, seed=0).random(int(n_starts) - 1) - 1.0) * half, lo, hi))

@@ -340,7 +340,9 @@ def failure_cause(state: State) -> str | None:
 
 
 def describe_failure(state: State, model: Model) -> str:
-    """Host: what failed at ``state.bad_step`` and the likely cause, in words (empty if healthy)."""
+    """Host: what failed at ``state.bad_step`` and the likely cause, in words (empty if healthy),
+    starting ``"step N (t = ...)"``: the callers say it failed (``simulation failed at ...`` here,
+    ``simulation failed: ...`` in a forming summary)."""
     bad = int(state.bad_step)
     if bad < 0:
         return ""
@@ -351,7 +353,7 @@ def describe_failure(state: State, model: Model) -> str:
         f" With a fibre mass (x{fm:g}) but not its momentum term, turning elements can also gain energy from "
         "the position-dependent mass: turn the term on (forming cases: numerics.fibre_mass_momentum_term = true) "
         "or lower the factor (numerics.fibre_mass_scaling).")
-    return (f"simulation failed at step {bad} (t = {bad * dt:.6e} s): {failure_cause(state)}. "
+    return (f"step {bad} (t = {bad * dt:.6e} s): {failure_cause(state)}. "
             f"Likely cause: the time step {dt:.3e} s is too large for the mesh (stable estimate of the "
             f"shell {stable:.3e} s{f', fibre mass x{fm:g}' if fm != 1.0 else ''}; contact stiffness adds to it), "
             "or a distorted/inverted element in the mesh; reduce dt, use mass scaling, or refine/clean the mesh." + pump)
@@ -364,7 +366,7 @@ def check(state: State, frames: Frames, model: Model):
     bad = int(state.bad_step)
     ok = np.asarray(frames.ok)
     good = jax.tree_util.tree_map(lambda a: a[: int(ok.sum())], frames)
-    raise SimulationError(f"{describe_failure(state, model)} {int(ok.sum())} good frames are in .frames.",
+    raise SimulationError(f"simulation failed at {describe_failure(state, model)} {int(ok.sum())} good frames are in .frames.",
                           step=bad, time=bad * float(model.dt), cause=failure_cause(state), frames=good,
                           state=state)
 

@@ -218,3 +218,34 @@ def test_a_given_contact_safety_that_breaks_the_step_budget_is_warned_about():
         warnings.simplefilter("error", RuntimeWarning)
         auto = forming.build(_coarse("case-a-woven-nlbm", process__frames=2)).info.numerics
     assert auto.budget <= 0.9 + 1e-9
+
+
+def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
+    """The driver's step cut (``driver.MAX_STEP_CUT``): a 25 mm rig whose automatic step is 1.64x
+    its stable estimate (``dt_safety = 2``) grows an unstable mode and fails at step 21 of 600
+    (measured); the driver runs that chunk again from its start with half the step, and the rest
+    of the run too: the run completes, its summary says where and why, and it forms the part as the
+    run at the usual step does (draw-in within 1 %). Run as a batch of one, the member goes on
+    alone with the same cut. A step the user gives is never cut
+    (``test_cli_run.test_failed_run_keeps_its_frames_and_says_why``)."""
+    from jaxform.forming import batch, driver
+
+    case = _coarse("case-a-woven-nlbm", **{"process.stroke_mm": 4, "process.frames": 3,
+                                           "contact.expected_pressure_Pa": 1e2})
+    usual = forming.run(forming.build(case), catch=True)
+    with pytest.warns(RuntimeWarning, match="above the estimated stable limit"):
+        rig = forming.build(case, dt_safety=2.0)
+    assert rig.info.numerics.governed_by == "shell" and rig.info.dt > 1.5 * rig.info.stable_dt
+    cut = forming.run(rig, catch=True)
+    assert usual.complete and cut.complete, (usual.reason, cut.reason)
+    assert usual.step_cuts == [] and usual.summary["numerics"]["step_cuts_count"] == 0
+    (c,) = cut.step_cuts
+    assert c["cut"] == 2 and 0 < c["step"] < rig.info.n_steps and "energy" in c["cause"]
+    n = cut.summary["numerics"]
+    assert n["step_cuts_count"] == 1 and n["step_cuts"] == [c] and n["smallest_dt_s"] == rig.info.dt / 2
+    assert n["steps_done"] == rig.info.n_steps and abs(cut.t[-1] - usual.t[-1]) < 1e-9
+    d_usual, d_cut = usual.summary["draw_in"]["edge_mid_m"], cut.summary["draw_in"]["edge_mid_m"]
+    assert d_usual > 1e-4 and abs(d_cut / d_usual - 1.0) < 0.01, (d_usual, d_cut)
+    assert driver.MAX_STEP_CUT == 8
+    (member,) = batch.run_part([rig])
+    assert member.complete and member.step_cuts == cut.step_cuts, (member.reason, member.step_cuts)

@@ -18,11 +18,12 @@ from jaxform.cli.sweep import member_names, parse_vary, split_values
 from jaxform.forming import batch
 from helpers import FAST, FAST_SET
 
-# the 1e13 Pa/m members are meant to blow up: build warns about them, as it should
+# the 1e16 Pa/m members are meant to blow up (even with the step cut to 1/8: omega dt ~ 400): build warns
+# about them, as it should
 pytestmark = pytest.mark.filterwarnings("ignore:forming.build. the time step and contact stiffness:RuntimeWarning")
 
 BASE = ["--element-size-mm", "25", "--set", "process.stroke_mm=4", "--set", "process.frames=3", *FAST_SET]
-VARY = ["--vary", "fabric.friction_tool=0.2,0.3", "--vary", "contact.penalty_stiffness_Pa_per_m=auto,1e13,1e3"]
+VARY = ["--vary", "fabric.friction_tool=0.2,0.3", "--vary", "contact.penalty_stiffness_Pa_per_m=auto,1e16,1e3"]
 
 
 def _case(*overrides):
@@ -37,7 +38,7 @@ def _rows(path):
 
 @pytest.fixture(scope="module")
 def swept(tmp_path_factory):
-    """One sweep of 6 members (friction x contact stiffness; the 1e13 Pa/m members blow up, the
+    """One sweep of 6 members (friction x contact stiffness; the 1e16 Pa/m members blow up, the
     1e3 Pa/m ones cannot be built), in this process, the 4 that run sharded over the two CPU
     devices of the test session."""
     out = tmp_path_factory.mktemp("sweep") / "out"
@@ -128,7 +129,8 @@ def test_sweep_writes_each_member_like_a_run_and_a_table(swept):
         if r["complete"] == "True":
             assert len(list(d.glob("frames_*.vtu"))) == 3 and float(r["max_shear_angle_deg"]) > 0
         else:  # a failed member keeps its frames so far and says why; the others went on
-            assert "energy blow-up" in r["reason"] and not s["complete"] and s["reason"] == r["reason"]
+            assert "energy blow-up" in r["reason"] and r["reason"].count("simulation failed") == 1
+            assert not s["complete"] and s["reason"] == r["reason"]
             assert 1 <= len(list(d.glob("frames_*.vtu"))) < 3
     assert (out / "sweep_fabric.friction_tool.png").is_file()
     assert (out / "sweep_contact.penalty_stiffness_Pa_per_m.png").is_file()

@@ -27,9 +27,9 @@ How members share a program:
 * **Failures.** The host checks every member after each stretch, as the single-run driver does
   (energy balance, non-finite values, physical bounds). A failed member keeps its frames up to its
   last good one and its reason, and is parked (its initial state, zero steps) while the others go
-  on. A member with a fibre mass but not its momentum term then goes on alone from its last good
-  state with the term on, after the batch, as its own run would
-  (:func:`jaxform.forming.driver.run`; ``momentum_term_from`` of its result).
+  on. Where its own run would run the failed chunk again (with the fibre mass's momentum term, or
+  a cut step: :meth:`jaxform.forming.driver.Standing.recover`), the member goes on alone from its
+  last good state that way, after the batch (``momentum_term_from`` and ``step_cuts`` of its result).
 * **Memory.** A group whose program would not fit in the memory the devices have is split into
   parts that do, run one after the other; ``summary["batch"]`` says so (:func:`plan_parts`).
 
@@ -56,7 +56,7 @@ from jax.sharding import PartitionSpec as P
 from jaxform import integrate
 from jaxform.batching import BATCH_AXIS
 from jaxform.forming.case import Case, to_dict
-from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive,
+from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive, may_cut_step,
                                     out_of_bounds_message, physical_causes)
 from jaxform.forming.fields import SCALARS, state_fields
 from jaxform.forming.presets import apply_overrides, with_element_size
@@ -423,9 +423,10 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                                 float(np.asarray(fl["punch_displacement"])[i]), time.perf_counter() - t_wall)
             if not active[:B].any():
                 break
-        for i in range(B):  # as its own run would: a fast fibre mass that failed goes on with its exact term
-            at = None if last_good[i] is None else Standing(_member(model, axes, i), last_good[i])
-            if at is None or not at.switch(recs[i], causes[i]):
+        for i in range(B):  # as its own run would: a failed member goes on alone with what may keep it stable
+            at = None if last_good[i] is None else Standing(_member(model, axes, i), last_good[i],
+                                                            may_cut=may_cut_step(infos[i]))
+            if at is None or not at.recover(recs[i], causes[i]):
                 continue
             alone[i] = at
             try:
@@ -452,7 +453,7 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
             history={k: np.asarray(v) for k, v in rec.hist.items()}, faces=infos[i].faces, ply_id=infos[i].ply_id,
             info=infos[i], complete=reasons[i] is None, reason=reasons[i], wall_time_s=wall, summary={},
             final_state=final, model=alone[i].model if i in alone else _member(model, axes, i),
-            momentum_term_from=alone[i].switched if i in alone else None)
+            momentum_term_from=alone[i].switched if i in alone else None, step_cuts=alone[i].cuts if i in alone else [])
         res.summary = summarize(res)
         res.summary["batch"] = {"members": B, "devices": D, "padded_to": Bp, "why": label,
                                 "wall_time_is": "the program's, shared by its members"}

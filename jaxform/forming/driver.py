@@ -6,9 +6,10 @@ energy-balance residual above half the largest energy seen, with a floor of :dat
 so that float32 rounding at the start of a run never counts); the driver reads that record and
 checks after every chunk that the run stays physical (fibre strain, node speeds, the part inside
 the rig: :class:`~jaxform.forming.rig.HealthBounds`). A run that fails either way stops with
-``complete = False``, the step, time and cause, and the frames up to the last good one; with a
-fibre mass but not its momentum term, the failing chunk is first run again with the term
-(:func:`run`).
+``complete = False``, the step, time and cause, and the frames up to the last good one. Before
+that, a failing chunk is run again from its start with what may keep it stable (:func:`run`):
+with a fibre mass but not its momentum term, with the term; where the step was chosen
+automatically, with the step halved (down to 1/:data:`MAX_STEP_CUT`).
 """
 from __future__ import annotations
 
@@ -32,6 +33,17 @@ BLOWUP_TOL = 0.5
 ENERGY_FLOOR = {"float32": 1e-3, "float64": 1e-8}
 """J: an energy-balance residual below this never counts as a blow-up (float32 rounding noise of
 the accounts; the shell itself works on displacements, see :class:`jaxform.shell.ShellRef`)."""
+
+
+MAX_STEP_CUT = 8
+"""The driver cuts an automatic step down to this fraction at most (halving it three times) for a
+chunk that fails at the run's step, e.g. a fold snapping through at metres per second in a
+quasi-static run: the step is chosen for the run's quasi-static state, and a dynamic event (faster
+contacts, the fibre mass's momentum term growing with the square of the speed) may need less. The
+cut stays for the rest of the run: a step that grew an unstable mode slowly enough to pass the
+energy check leaves its spurious energy in the accounts, and a later chunk then fails at any step
+(measured: a 25 mm rig at 1.6x its stable estimate, going back up after each cut chunk, failed
+again six steps later even with 1/8 of the step). A step the user gave is never cut."""
 
 
 def _floor(state) -> float:
@@ -82,6 +94,8 @@ class FormingResult:
         momentum_term_from: where the driver switched the fibre mass's momentum term on
         (``step``, ``t_s``, ``punch_displacement_m``, the ``cause`` of the chunk that failed
         without it), None if it did not (:func:`run`).
+        step_cuts: where the driver cut the step (the same keys and ``cut``: the step was the
+            run's over ``cut`` from there, for that chunk), in order (:func:`run`).
     """
 
     t: np.ndarray
@@ -98,6 +112,7 @@ class FormingResult:
     final_state: Any = None
     model: Any = None
     momentum_term_from: dict | None = None
+    step_cuts: list = dataclasses.field(default_factory=list)
 
     @property
     def shear_angle_deg(self) -> np.ndarray:
@@ -189,10 +204,24 @@ def _check_health(state, fl, info: RunInfo, last_good) -> None:
                                     state=last_good)
 
 
-def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo):
-    """One host chunk of ``n_sub`` steps from ``state``: ``(new_state, fields)``, or
-    :class:`~jaxform.integrate.SimulationError` when a step failed or the run left its bounds."""
-    new = _advance_jit(model, state, e0, x_ref, n_sub, floor)
+def _cut_advance(model, state, e0, x_ref, n_sub, floor, cut: int):
+    """``n_sub`` steps of ``model.dt`` as ``cut`` times as many of ``model.dt / cut`` (the same
+    compiled program: the step is a leaf of the model). The integrator's time is its step count
+    times its step, so the count runs in cut steps inside and in the run's steps outside (the
+    chunk ends on a whole step of the run; a failing step is reported as the run's step it falls in)."""
+    if cut == 1:
+        return _advance_jit(model, state, e0, x_ref, n_sub, floor)
+    fine = dataclasses.replace(model, dt=model.dt / cut)
+    new = _advance_jit(fine, dataclasses.replace(state, step=state.step * cut), e0, x_ref, n_sub * cut, floor)
+    bad = jnp.where(new.bad_step >= 0, new.bad_step // cut, new.bad_step)
+    return dataclasses.replace(new, step=new.step // cut, bad_step=bad)
+
+
+def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo, cut: int = 1):
+    """One host chunk of ``n_sub`` steps from ``state`` (with the step cut to ``1/cut``):
+    ``(new_state, fields)``, or :class:`~jaxform.integrate.SimulationError` when a step failed
+    or the run left its bounds."""
+    new = _cut_advance(model, state, e0, x_ref, n_sub, floor, cut)
     if int(new.bad_step) >= 0:
         raise integrate.SimulationError(
             integrate.describe_failure(new, model) + " The frames up to the last good one are kept.",
@@ -221,6 +250,13 @@ class Standing:
     model: Any
     state: Any
     switched: dict | None = None
+    may_cut: bool = True
+    cut: int = 1
+    cuts: list = dataclasses.field(default_factory=list)
+
+    def _where(self, rec: "Recorder", cause: str) -> dict:
+        return {"step": int(self.state.step), "t_s": float(self.state.t),
+                "punch_displacement_m": float(rec.hist["punch_displacement_m"][-1]), "cause": cause}
 
     def switch(self, rec: "Recorder", cause: str) -> bool:
         """Switch the momentum term on from the last good state because a chunk failed with
@@ -229,29 +265,44 @@ class Standing:
         if exact is None:
             return False
         self.model = exact
-        self.switched = {"step": int(self.state.step), "t_s": float(self.state.t),
-                         "punch_displacement_m": float(rec.hist["punch_displacement_m"][-1]), "cause": cause}
+        self.switched = self._where(rec, cause)
+        return True
+
+    def recover(self, rec: "Recorder", cause: str) -> bool:
+        """What to change before the chunk that failed with ``cause`` runs again from the last
+        good state: the momentum term (:meth:`switch`), else half the step (down to
+        1/:data:`MAX_STEP_CUT`, an automatic step only); False where nothing is left to change."""
+        if self.switch(rec, cause):
+            return True
+        if not self.may_cut or self.cut >= MAX_STEP_CUT:
+            return False
+        self.cut *= 2
+        self.cuts.append({**self._where(rec, cause), "cut": self.cut})
         return True
 
 
 def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progress: Callable | None = None,
           t_wall: float | None = None) -> None:
     """Run the chunks of ``info`` still to do from ``at.state`` (its step says how many are done),
-    sampling and writing frames into ``rec``. A chunk that fails with a fibre mass but not its
-    momentum term is run again from its start with the term, and so is the rest (:func:`run`).
-    Raises :class:`~jaxform.integrate.SimulationError` on a failure it cannot switch away; ``at``
-    then holds the last good state."""
+    sampling and writing frames into ``rec``. A chunk that fails is run again from its start
+    with what :meth:`Standing.recover` changes (:func:`run`), and so is the rest. Raises :class:`~jaxform.integrate.SimulationError` on a failure
+    nothing is left to change for; ``at`` then holds the last good state."""
     t_wall = time.perf_counter() if t_wall is None else t_wall
     ply_arr = jnp.asarray(info.ply_id)
     floor = jnp.asarray(_floor(at.state), at.state.x.dtype)
     n_sub = jnp.asarray(info.sub_steps, jnp.int32)
     for c in range(int(at.state.step) // info.sub_steps, (info.n_frames - 1) * info.samples_per_frame):
-        try:
-            new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info)
-        except integrate.SimulationError as err:
-            if not at.switch(rec, err.cause):
-                raise
-            new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info)
+        while True:
+            try:
+                new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info, at.cut)
+                break
+            except integrate.SimulationError as err:
+                if not at.recover(rec, err.cause):
+                    if at.cut > 1:
+                        raise integrate.SimulationError(
+                            f"{err} It failed also with the step cut to 1/{at.cut}.", step=err.step, time=err.time,
+                            cause=err.cause, frames=err.frames, state=err.state) from err
+                    raise
         at.state = new
         rec.sample(new, fl)
         if on_progress is not None:
@@ -265,14 +316,21 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
         build_only: bool = False) -> FormingResult:
     """Run a built rig on the host, chunk by chunk (``info.sub_steps`` steps per jitted call).
 
-    A chunk that fails (a step, or the run's bounds) with a fibre mass but not its momentum term
-    is run again from its start with the term, and so is the rest of the run
+    A chunk that fails (a step, or the run's bounds) is run again from its start, as often as
+    :meth:`Standing.recover` finds something to change. With a fibre mass but not its momentum
+    term, first with the term, and so is the rest of the run
     (``momentum_term_from`` of the result, ``numerics.fibre_mass_momentum_term_choice`` of the
     summary). Without the term the position-dependent mass can pump energy into elements that
     turn fast (a whipping corner, a snapping wrinkle) within a few hundred steps; the term removes
     that at about twice a step's cost, so it is paid only from where it was needed. Measured:
     woven Case A LBM B_inf, 4 mm, blew up at 90 % of the stroke within one chunk (the energy
-    residual was 0.3 % of the largest energy at the chunk's start).
+    residual was 0.3 % of the largest energy at the chunk's start). Then, where the step was
+    chosen automatically (:func:`may_cut_step`), with half the step, then a quarter, then an
+    eighth (:data:`MAX_STEP_CUT`): the chunk's steps are run as two, four or eight steps each, and
+    so are the rest of the run's (``step_cuts`` of the result, ``numerics.step_cuts`` of the
+    summary). Why: ``case-a-ncf-nlbm`` at 4 mm and the quasi-static 31.25 mm/s blew up at
+    95 % of the stroke after a sudden event (node speeds 0.8 -> 7.9 m/s at a 0.031 m/s punch); a
+    step chosen for the quasi-static run need not hold through a snap.
 
     Args:
         rig: :func:`jaxform.forming.build`'s ``(model, state, info)``.
@@ -287,7 +345,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     """
     t_wall = time.perf_counter()
     model, state, info = rig
-    at = Standing(model, state)
+    at = Standing(model, state, may_cut=may_cut_step(info))
     rec = Recorder(on_frame)
     complete, reason = False, None
     try:
@@ -315,9 +373,14 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
         t=np.asarray(rec.t), x=np.asarray(rec.x), fields={k: np.asarray(v) for k, v in rec.fields.items()},
         history={k: np.asarray(v) for k, v in rec.hist.items()}, faces=info.faces, ply_id=info.ply_id, info=info,
         complete=complete, reason=reason, wall_time_s=time.perf_counter() - t_wall, summary={}, final_state=at.state,
-        model=at.model, momentum_term_from=at.switched)
+        model=at.model, momentum_term_from=at.switched, step_cuts=at.cuts)
     result.summary = summarize(result)
     return result
+
+
+def may_cut_step(info: RunInfo) -> bool:
+    """Whether the driver may cut the run's step (:data:`MAX_STEP_CUT`): not where the user gave it."""
+    return getattr(getattr(info, "numerics", None), "governed_by", None) != "user"
 
 
 def simulate(case: Case, *, dtype=None, element_size: float | None = None, overrides=(),
@@ -353,5 +416,5 @@ def simulate(case: Case, *, dtype=None, element_size: float | None = None, overr
     return result
 
 
-__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "run_steps", "rollout", "FormingResult", "Standing", "drive", "with_momentum_term", "run", "simulate", "physical_causes",
+__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "MAX_STEP_CUT", "may_cut_step", "run_steps", "rollout", "FormingResult", "Standing", "drive", "with_momentum_term", "run", "simulate", "physical_causes",
            "out_of_bounds_message"]

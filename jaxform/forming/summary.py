@@ -95,6 +95,18 @@ def _momentum_term(result) -> dict:
             "fibre_mass_momentum_term_from_step": None if sw is None else int(sw["step"])}
 
 
+STEP_CUTS_LISTED = 20
+"""The summary lists this many of a run's step cuts (the first), and counts them all."""
+
+
+def _step_cuts(result) -> dict:
+    """Where the driver cut the step (:data:`jaxform.forming.driver.MAX_STEP_CUT`): ``step_cuts``
+    (the first :data:`STEP_CUTS_LISTED`: step, time, punch, cut, cause) and how many there were."""
+    cuts = list(getattr(result, "step_cuts", None) or [])
+    return {"step_cuts_count": len(cuts), "smallest_dt_s": result.info.dt / max([1] + [c["cut"] for c in cuts]),
+            "step_cuts": [dict(c) for c in cuts[:STEP_CUTS_LISTED]]}
+
+
 def summarize(result) -> dict:
     """The summary of a :class:`~jaxform.forming.driver.FormingResult` (SPEC section 6 keys and more; JSON-ready)."""
     import jaxform
@@ -138,7 +150,8 @@ def summarize(result) -> dict:
                      "fibre_mass_degree": getattr(getattr(result.model, "fibre_mass", None), "degree", None),
                      "dtype": case.dtype,
                      "punch_speed_m_per_s": float(case.process.speed),
-                     "speed_choice": case.process.speed_choice or "given", **_step_choice(info, h)},
+                     "speed_choice": case.process.speed_choice or "given", **_step_choice(info, h),
+                     **_step_cuts(result)},
         "max_ke_ie": max_ke_ie,
         "max_shear_angle_deg": max_shear,
         "max_flange_deviation_m": max_dev,

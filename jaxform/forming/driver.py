@@ -94,8 +94,8 @@ class FormingResult:
         momentum_term_from: where the driver switched the fibre mass's momentum term on
         (``step``, ``t_s``, ``punch_displacement_m``, the ``cause`` of the chunk that failed
         without it), None if it did not (:func:`run`).
-        step_cuts: where the driver cut the step (the same keys and ``cut``: the step was the
-            run's over ``cut`` from there, for that chunk), in order (:func:`run`).
+        step_cuts: where the driver cut the step (the same keys and ``cut``: from that chunk on
+            the step was the run's over ``cut``), in order (:func:`run`).
     """
 
     t: np.ndarray
@@ -285,8 +285,9 @@ def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progres
           t_wall: float | None = None) -> None:
     """Run the chunks of ``info`` still to do from ``at.state`` (its step says how many are done),
     sampling and writing frames into ``rec``. A chunk that fails is run again from its start
-    with what :meth:`Standing.recover` changes (:func:`run`), and so is the rest. Raises :class:`~jaxform.integrate.SimulationError` on a failure
-    nothing is left to change for; ``at`` then holds the last good state."""
+    with what :meth:`Standing.recover` changes (:func:`run`), and so is the rest. Raises
+    :class:`~jaxform.integrate.SimulationError` on a failure nothing is left to change for;
+    ``at`` then holds the last good state."""
     t_wall = time.perf_counter() if t_wall is None else t_wall
     ply_arr = jnp.asarray(info.ply_id)
     floor = jnp.asarray(_floor(at.state), at.state.x.dtype)

@@ -238,11 +238,11 @@ def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
     assert rig.info.numerics.governed_by == "shell" and rig.info.dt > 1.5 * rig.info.stable_dt
     cut = forming.run(rig, catch=True)
     assert usual.complete and cut.complete, (usual.reason, cut.reason)
-    assert usual.step_cuts == [] and usual.summary["numerics"]["step_cuts_count"] == 0
+    assert usual.step_cuts == [] and usual.summary["numerics"]["step_cuts"] == []
     (c,) = cut.step_cuts
     assert c["cut"] == 2 and 0 < c["step"] < rig.info.n_steps and "energy" in c["cause"]
     n = cut.summary["numerics"]
-    assert n["step_cuts_count"] == 1 and n["step_cuts"] == [c] and n["smallest_dt_s"] == rig.info.dt / 2
+    assert n["step_cuts"] == [c] and n["smallest_dt_s"] == rig.info.dt / 2
     assert n["steps_done"] == rig.info.n_steps and abs(cut.t[-1] - usual.t[-1]) < 1e-9
     d_usual, d_cut = usual.summary["draw_in"]["edge_mid_m"], cut.summary["draw_in"]["edge_mid_m"]
     assert d_usual > 1e-4 and abs(d_cut / d_usual - 1.0) < 0.01, (d_usual, d_cut)

@@ -216,11 +216,11 @@ def report(result, written, out, stream=None):
             print(f"  warning: a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set "
                   f"for {n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the "
                   "expected one; raise contact.expected_pressure_Pa for a stiffer contact", file=stream)
-        if n.get("step_cuts_count"):
+        if n.get("step_cuts"):
             c = n["step_cuts"][0]
-            print(f"  note: {n['step_cuts_count']} chunk(s) failed at the run's step and ran again with a smaller one "
-                  f"(down to {n['smallest_dt_s']:.3g} s; the first from step {c['step']}, t = {c['t_s']:.4g} s, punch "
-                  f"{1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']}): a fast event, not quasi-static there",
+            print(f"  note: a chunk failed at the run's step from step {c['step']} (t = {c['t_s']:.4g} s, punch "
+                  f"{1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']}); the run went on from there with "
+                  f"{n['smallest_dt_s']:.3g} s ({len(n['step_cuts'])} cut(s)): a fast event, not quasi-static there",
                   file=stream)
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)

@@ -251,8 +251,12 @@ class Standing:
     state: Any
     switched: dict | None = None
     may_cut: bool = True
-    cut: int = 1
     cuts: list = dataclasses.field(default_factory=list)
+
+    @property
+    def cut(self) -> int:
+        """The step runs at the run's over this (1 until :meth:`recover` cuts it)."""
+        return self.cuts[-1]["cut"] if self.cuts else 1
 
     def _where(self, rec: "Recorder", cause: str) -> dict:
         return {"step": int(self.state.step), "t_s": float(self.state.t),
@@ -276,8 +280,7 @@ class Standing:
             return True
         if not self.may_cut or self.cut >= MAX_STEP_CUT:
             return False
-        self.cut *= 2
-        self.cuts.append({**self._where(rec, cause), "cut": self.cut})
+        self.cuts.append({**self._where(rec, cause), "cut": 2 * self.cut})
         return True
 
 

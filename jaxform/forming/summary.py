@@ -95,16 +95,11 @@ def _momentum_term(result) -> dict:
             "fibre_mass_momentum_term_from_step": None if sw is None else int(sw["step"])}
 
 
-STEP_CUTS_LISTED = 20
-"""The summary lists this many of a run's step cuts (the first), and counts them all."""
-
-
 def _step_cuts(result) -> dict:
-    """Where the driver cut the step (:data:`jaxform.forming.driver.MAX_STEP_CUT`): ``step_cuts``
-    (the first :data:`STEP_CUTS_LISTED`: step, time, punch, cut, cause) and how many there were."""
-    cuts = list(getattr(result, "step_cuts", None) or [])
-    return {"step_cuts_count": len(cuts), "smallest_dt_s": result.info.dt / max([1] + [c["cut"] for c in cuts]),
-            "step_cuts": [dict(c) for c in cuts[:STEP_CUTS_LISTED]]}
+    """Where the driver cut the step (:data:`jaxform.forming.driver.MAX_STEP_CUT`; a cut stays, so
+    at most three): ``step_cuts`` (step, time, punch, cut, cause each) and the step the run ended with."""
+    cuts = [dict(c) for c in getattr(result, "step_cuts", None) or []]
+    return {"step_cuts": cuts, "smallest_dt_s": result.info.dt / (cuts[-1]["cut"] if cuts else 1)}
 
 
 def summarize(result) -> dict:

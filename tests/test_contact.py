@@ -6,7 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform import contact, tools
+from jaxform import contact, penalty, tools
 
 H = 0.3e-3  # ply thickness, m
 RHO_A = 0.21  # kg/m²
@@ -126,7 +126,7 @@ def test_node_on_tilted_plate_starts_sliding_at_the_friction_angle():
     mu, eps, g = 0.36, 1e-4, 9.81
     area, dt = 1e-6, 1e-5
     m = RHO_A * area
-    k = contact.auto_penalty_stiffness(RHO_A, dt)
+    k = penalty.auto_penalty_stiffness(RHO_A, dt)
     params = contact.ContactParams(stiffness=k, friction=mu, slip_velocity=eps,
                                    damping=2 * 0.5 * math.sqrt(k * RHO_A))
 
@@ -156,7 +156,7 @@ def test_node_on_tilted_plate_starts_sliding_at_the_friction_angle():
 
 def test_auto_penalty_stiffness_is_stable_and_stiff():
     dt = 1e-6
-    k = contact.auto_penalty_stiffness(RHO_A, dt)
+    k = penalty.auto_penalty_stiffness(RHO_A, dt)
     np.testing.assert_allclose(k, 0.1 * RHO_A / dt**2)
     np.testing.assert_allclose(math.sqrt(k / RHO_A) * dt, math.sqrt(0.1))
     # Penetration under 18.5 kPa (1000 N on the holder ring) is far below h.
@@ -170,13 +170,13 @@ def test_auto_penalty_stiffness_is_stable_and_stiff():
         return abs(z)
     with np.errstate(over="ignore", invalid="ignore"):
         assert peak(k) < 2e-7 and not peak(50 * k) < 1e-3
-    p = contact.contact_params(RHO_A, dt, H, friction=0.23)
+    p = penalty.contact_params(RHO_A, dt, H, friction=0.23)
     assert float(p.stiffness) == pytest.approx(k) and float(p.damping) > 0
-    assert float(contact.contact_params(RHO_A, dt, H, stiffness=1e12).stiffness) == 1e12
+    assert float(penalty.contact_params(RHO_A, dt, H, stiffness=1e12).stiffness) == 1e12
     with pytest.raises(ValueError, match="penetration"):
-        contact.contact_params(RHO_A, 1e-3, H)
+        penalty.contact_params(RHO_A, 1e-3, H)
     with pytest.raises(ValueError, match="dt"):
-        contact.auto_penalty_stiffness(RHO_A, 0.0)
+        penalty.auto_penalty_stiffness(RHO_A, 0.0)
 
 
 def test_holder_step_under_constant_force():
@@ -243,7 +243,7 @@ def test_tool_load_hook_force_controlled_holder_settles_on_the_fabric():
     area = np.full(n, 5.4e-2 / n)  # the holder ring of the 250 mm blank
     xs = np.column_stack([np.linspace(0.06, 0.12, n), np.zeros(n), np.full(n, H / 2)])
     dt = 1e-6
-    params = contact.contact_params(RHO_A, dt, H, friction=0.23)
+    params = penalty.contact_params(RHO_A, dt, H, friction=0.23)
     holder = tools.BlankHolder(0.053, bottom_z=H)
     load = contact.ToolLoad(tool=holder, params=params, offset=H / 2, area=area, active=np.ones(n),
                             clamp_force=1000.0, mass=5.0, damping=2 * math.sqrt(float(params.stiffness) * 5.4e-2 * 5.0),
@@ -285,10 +285,10 @@ def test_stick_under_high_pressure_is_stable_with_the_stick_limit():
     """Explicit stick: the regularised friction is a damper ``mu p A / eps_v`` on the node. With
     ``mu p dt / (eps_v rho_A) = 5`` (a clamped holder, 1% regularisation, 8 mm mesh) the plain law
     makes the slip velocity flip sign every step and grow; the stick limit of
-    :func:`contact.contact_params` keeps it decaying without a sign change."""
+    :func:`penalty.contact_params` keeps it decaying without a sign change."""
     dt, p, mu, area = 2.0e-6, 1.5e4, 0.23, 6.4e-5
     eps = mu * p * dt / (5.0 * RHO_A)
-    base = contact.contact_params(RHO_A, dt, H, friction=mu, slip_velocity=eps)
+    base = penalty.contact_params(RHO_A, dt, H, friction=mu, slip_velocity=eps)
     assert float(base.stick_limit) == pytest.approx(dt / RHO_A)
     plain = contact.ContactParams(stiffness=base.stiffness, friction=mu, slip_velocity=eps)
     depth = p / float(base.stiffness)
@@ -308,4 +308,4 @@ def test_stick_under_high_pressure_is_stable_with_the_stick_limit():
     flips = np.sum(np.sign(out["plain"][1:]) != np.sign(out["plain"][:-1]))
     assert flips >= 20 and abs(out["plain"][-1]) > 1e-5  # the test sees chatter where it exists
     # two-sided (ply on ply) contact: twice the limit (two nodes share the slip)
-    assert float(contact.contact_params(RHO_A, dt, H, two_sided=True).stick_limit) == pytest.approx(2 * dt / RHO_A)
+    assert float(penalty.contact_params(RHO_A, dt, H, two_sided=True).stick_limit) == pytest.approx(2 * dt / RHO_A)

@@ -11,7 +11,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform import contact, integrate, tools
+from jaxform import contact, integrate, penalty, tools
 from jaxform._pytree import pytree_dataclass
 from jaxform.materials import WOVEN_38616
 from jaxform.mesh import Mesh
@@ -45,7 +45,7 @@ def test_pressure_patch_gives_back_the_applied_pressure():
     p = 2.0e4
     area = jnp.asarray(mesh.node_area)
     base = integrate.make_model(shell, mass_scale=100.0)
-    params = contact.contact_params(float(WOVEN_38616.areal_mass) * 100.0, float(base.dt), H, friction=0.23,
+    params = penalty.contact_params(float(WOVEN_38616.areal_mass) * 100.0, float(base.dt), H, friction=0.23,
                                     expected_pressure=p, damping_ratio=0.5)
     plate = tools.Plane(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
     load = contact.ToolLoad(tool=plate, params=params, offset=H / 2, area=area, active=jnp.ones(mesh.n_nodes))
@@ -65,7 +65,7 @@ def _slide(angle_deg, mu=0.23, T=0.2):
     g = 9.81 * np.array([math.sin(th), 0.0, -math.cos(th)])
     base = integrate.make_model(shell, mass_scale=ms)
     dt = float(base.dt)
-    params = contact.contact_params(float(WOVEN_38616.areal_mass) * ms, dt, H, friction=mu, slip_velocity=1e-5,
+    params = penalty.contact_params(float(WOVEN_38616.areal_mass) * ms, dt, H, friction=mu, slip_velocity=1e-5,
                                     expected_pressure=3e4)
     plate = tools.Plane(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0))
     load = contact.ToolLoad(tool=plate, params=params, offset=H / 2, area=jnp.asarray(mesh.node_area),

@@ -8,7 +8,7 @@ import jax
 import jax.numpy as jnp
 import pytest
 
-from jaxform import broadphase, cases, contact
+from jaxform import broadphase, cases, contact, penalty
 from jaxform.geometry import closest_points_segments, point_triangle_sqdist
 from jaxform.metrics.intersections import triangulate
 from jaxform.self_contact import SelfContactLoad, edge_contact, mesh_edges, near_edges, self_contact_load
@@ -317,14 +317,14 @@ def _squeeze_strip(self_contact, *, length=0.06, width=0.004, n_len=60, gap_h=6.
     dt = 0.5 * stable_time_step(shell, mass_scale=mass_scale, safety=1.0)
     rho = float(fab.areal_mass) * mass_scale
     f32 = lambda a: jnp.asarray(a, jnp.float64)  # noqa: E731  (float64 as the shell: the tests' x64)
-    params = contact.contact_params(rho, dt, h, friction=0.23, slip_velocity=0.01 * speed)
+    params = penalty.contact_params(rho, dt, h, friction=0.23, slip_velocity=0.01 * speed)
     area = np.asarray(mesh.node_area)
     loads = [contact.ToolLoad(tool=tools.Plane(point=f32((0.0, 0.0, s * 0.5 * gap_h * h)), normal=f32((0.0, 0.0, -s))),
                               params=params, offset=f32(h / 2), area=f32(area), active=f32(np.ones(n)))
              for s in (-1.0, 1.0)]
     sc = None
     if self_contact:
-        ps = contact.contact_params(rho, dt, h, friction=0.36, slip_velocity=0.01 * speed, two_sided=True, interfaces=2)
+        ps = penalty.contact_params(rho, dt, h, friction=0.36, slip_velocity=0.01 * speed, two_sided=True, interfaces=2)
         sc = self_contact_load(X, np.asarray(mesh.tris), area, np.zeros(n, int), h, ps, dtype=jnp.float64)
         loads.append(sc)
     model = integrate.make_model(shell, dt=dt, mass_scale=mass_scale, damping=damping,

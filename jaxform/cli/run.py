@@ -216,12 +216,16 @@ def report(result, written, out, stream=None):
             print(f"  warning: a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set "
                   f"for {n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the "
                   "expected one; raise contact.expected_pressure_Pa for a stiffer contact", file=stream)
-        if n.get("step_cuts"):
-            c = n["step_cuts"][0]
-            print(f"  note: a chunk failed at the run's step from step {c['step']} (t = {c['t_s']:.4g} s, punch "
-                  f"{1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']}); the run went on from there with "
-                  f"{n['smallest_dt_s']:.3g} s ({len(n['step_cuts'])} cut(s)): a fast event, not quasi-static there",
-                  file=stream)
+        cuts, k_before = n.get("step_cuts") or [], 1.0
+        for c in cuts:  # at most three: a cut stays
+            where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"
+            if c["contact_stiffness"] > k_before:
+                print(f"  note: the contact was stiffened to x{c['contact_stiffness']:g} with the step cut to 1/{c['cut']} "
+                      f"{where}: the pressures exceed the expected {n['expected_pressure_Pa']:.3g} Pa", file=stream)
+            else:
+                print(f"  note: a chunk failed at the run's step {where}; the run went on with the step cut to "
+                      f"1/{c['cut']}: a fast event, not quasi-static there", file=stream)
+            k_before = c["contact_stiffness"]
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)

@@ -27,8 +27,8 @@ How members share a program:
 * **Failures.** The host checks every member after each stretch, as the single-run driver does
   (energy balance, non-finite values, physical bounds). A failed member keeps its frames up to its
   last good one and its reason, and is parked (its initial state, zero steps) while the others go
-  on. Where its own run would run the failed chunk again (with the fibre mass's momentum term, or
-  a cut step: :meth:`jaxform.forming.driver.Standing.recover`), the member goes on alone from its
+  on. Where its own run would run the failed chunk again (with the fibre mass's momentum term, a
+  cut step, a stiffer contact: :meth:`jaxform.forming.driver.Standing.recover`), the member goes on alone from its
   last good state that way, after the batch (``momentum_term_from`` and ``step_cuts`` of its result).
 * **Memory.** A group whose program would not fit in the memory the devices have is split into
   parts that do, run one after the other; ``summary["batch"]`` says so (:func:`plan_parts`).
@@ -56,7 +56,7 @@ from jax.sharding import PartitionSpec as P
 from jaxform import integrate
 from jaxform.batching import BATCH_AXIS
 from jaxform.forming.case import Case, to_dict
-from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive, may_cut_step,
+from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive, may_stiffen_contact,
                                     out_of_bounds_message, physical_causes)
 from jaxform.forming.fields import SCALARS, state_fields
 from jaxform.forming.presets import apply_overrides, with_element_size
@@ -407,7 +407,8 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                     if hx is None:
                         hx, hs = np.asarray(new.x), (np.asarray(new.step), np.asarray(new.t))
                         hfl = {key: np.asarray(fl[key]) for key in SCALARS}
-                    out = physical_causes(hx[i], {key: v[i] for key, v in hfl.items()}, infos[i].bounds)
+                    out = physical_causes(hx[i], {key: v[i] for key, v in hfl.items()}, infos[i].bounds,
+                                          recs[i].hist["max_penetration_m"][-1] if may_stiffen_contact(infos[i]) else np.inf)
                     if out:
                         reasons[i] = "simulation failed: " + out_of_bounds_message(
                             int(hs[0][i]), float(hs[1][i]), float(hfl["punch_displacement"][i]), out)
@@ -424,8 +425,7 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
             if not active[:B].any():
                 break
         for i in range(B):  # as its own run would: a failed member goes on alone with what may keep it stable
-            at = None if last_good[i] is None else Standing(_member(model, axes, i), last_good[i],
-                                                            may_cut=may_cut_step(infos[i]))
+            at = None if last_good[i] is None else Standing.of(_member(model, axes, i), last_good[i], infos[i])
             if at is None or not at.recover(recs[i], causes[i]):
                 continue
             alone[i] = at

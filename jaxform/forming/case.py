@@ -43,7 +43,7 @@ import math
 from typing import Any
 
 from jaxform import units
-from jaxform.contact import stable_damping_ratio
+from jaxform.penalty import stable_damping_ratio
 from jaxform.forming.speed import quasi_static_speed
 
 BENDING_MODELS = ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")
@@ -111,7 +111,7 @@ class ProcessSpec:
 
 @dataclasses.dataclass(frozen=True)
 class ContactSpec:
-    """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.contact.contact_params`), its
+    """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.penalty.contact_params`), its
     stability ``safety`` (``(omega_c dt)^2`` of one contact; ``None``: automatic, chosen with the
     time step by :func:`jaxform.forming.numerics.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
     damping ratio; ``self_contact``: every ply with itself and the plies not next to it

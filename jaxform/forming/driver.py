@@ -9,7 +9,8 @@ the rig: :class:`~jaxform.forming.rig.HealthBounds`). A run that fails either wa
 ``complete = False``, the step, time and cause, and the frames up to the last good one. Before
 that, a failing chunk is run again from its start with what may keep it stable (:func:`run`):
 with a fibre mass but not its momentum term, with the term; where the step was chosen
-automatically, with the step halved (down to 1/:data:`MAX_STEP_CUT`).
+automatically, with the step halved (down to 1/:data:`MAX_STEP_CUT`), and where a node
+penetrated too deep an automatic contact, with the contact stiffened as well.
 """
 from __future__ import annotations
 
@@ -22,8 +23,10 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform import integrate
+from jaxform.penalty import rescaled_load
 from jaxform.forming.case import Case
 from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS, SCALARS, fields_jit
+from jaxform.forming.numerics import CONTACT_RAMP, CONTACT_STIFFEN
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, RunInfo, build
 from jaxform.forming.summary import summarize
@@ -94,8 +97,9 @@ class FormingResult:
         momentum_term_from: where the driver switched the fibre mass's momentum term on
         (``step``, ``t_s``, ``punch_displacement_m``, the ``cause`` of the chunk that failed
         without it), None if it did not (:func:`run`).
-        step_cuts: where the driver cut the step (the same keys and ``cut``: from that chunk on
-            the step was the run's over ``cut``), in order (:func:`run`).
+        step_cuts: where the driver cut the step (the same keys, ``cut``: from that chunk on
+            the step was the run's over ``cut``, and ``contact_stiffness``: the contacts' penalty
+            went to the run's times this), in order (:func:`run`).
     """
 
     t: np.ndarray
@@ -160,11 +164,24 @@ class Recorder:
             self.on_frame(k, float(s.t), self.x[-1], host)
 
 
-def physical_causes(x, fl, bounds) -> list[str]:
+PENETRATED = "a node penetrated a tool or ply by"
+"""How a cause of :func:`physical_causes` about a penetration begins (:func:`penetrated`)."""
+DEEPER = "the pressures exceed those the automatic contact was chosen for"
+"""How a cause about a penetration beyond ``stiffen_penetration`` (not half the ply) ends."""
+
+
+def penetrated(cause: str) -> bool:
+    """Whether a failure's cause (``"; "``-joined) names a penetration (:func:`physical_causes`)."""
+    return PENETRATED in cause
+
+
+def physical_causes(x, fl, bounds, stiffen_above: float = np.inf) -> list[str]:
     """Host: how a state (positions ``x`` (N, 3) m, its fields ``fl``) left the physical bounds of
     a run (:class:`~jaxform.forming.rig.HealthBounds`), in words; empty when it did not. A run can
     blow up without a NaN or an energy-balance jump: nodes flung away by an over-damped contact
-    still balance their energy."""
+    still balance their energy. A penetration beyond ``bounds.stiffen_penetration`` counts too
+    where it is also deeper than ``stiffen_above`` (m; the penetration at the chunk's start where
+    the contact may be stiffened: a growing one, not one that heals; ``inf``: never)."""
     b = bounds
     x = np.asarray(x)
     strain, speed = float(fl["max_fibre_strain"]), float(fl["max_node_speed"])
@@ -175,9 +192,11 @@ def physical_causes(x, fl, bounds) -> list[str]:
         causes.append(f"a node moves at {speed:.3g} m/s, beyond {b.speed:.3g} m/s (100 x the punch speed)")
     pen = float(fl.get("max_penetration", 0.0))
     if not pen <= b.penetration:
-        causes.append(f"a node penetrated a tool or ply by {pen * 1e3:.3g} mm, beyond {b.penetration * 1e3:.3g} mm "
+        causes.append(f"{PENETRATED} {pen * 1e3:.3g} mm, beyond {b.penetration * 1e3:.3g} mm "
                       "(half the ply): the contact is too soft for this case's pressures (raise "
                       "contact.expected_pressure_Pa)")
+    elif not pen <= max(b.stiffen_penetration, stiffen_above):
+        causes.append(f"{PENETRATED} {pen * 1e3:.3g} mm, beyond {b.stiffen_penetration * 1e3:.3g} mm and growing: {DEEPER}")
     lo, hi = x.min(axis=0), x.max(axis=0)
     if not (np.all(lo >= np.asarray(b.box_lo)) and np.all(hi <= np.asarray(b.box_hi))):
         far = max(float(np.max(np.asarray(b.box_lo) - lo)), float(np.max(hi - np.asarray(b.box_hi))))
@@ -192,10 +211,10 @@ def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
             "damping, mass scaling); the frames up to the last good one are kept.")
 
 
-def _check_health(state, fl, info: RunInfo, last_good) -> None:
+def _check_health(state, fl, info: RunInfo, last_good, stiffen_above: float = np.inf) -> None:
     """Raise :class:`~jaxform.integrate.SimulationError` when the run left the physical bounds of
-    ``info.bounds`` (:func:`physical_causes`)."""
-    causes = physical_causes(state.x, fl, info.bounds)
+    ``info.bounds`` (:func:`physical_causes`, ``stiffen_above`` as there)."""
+    causes = physical_causes(state.x, fl, info.bounds, stiffen_above)
     if not causes:
         return
     step, t = int(state.step), float(state.t)
@@ -204,23 +223,32 @@ def _check_health(state, fl, info: RunInfo, last_good) -> None:
                                     state=last_good)
 
 
+def rescaled(model, *, step: float = 1.0, stiffness: float = 1.0):
+    """``model`` with a time step ``step`` times as long and its contacts ``stiffness`` times as
+    stiff (:func:`jaxform.penalty.rescaled_load`: the stick limits and a force-controlled holder
+    follow the step): the same pytree structure, so the same compiled program runs it."""
+    return dataclasses.replace(model, dt=model.dt * step,
+                               loads=tuple(rescaled_load(ld, step=step, stiffness=stiffness) for ld in model.loads))
+
+
 def _cut_advance(model, state, e0, x_ref, n_sub, floor, cut: int):
     """``n_sub`` steps of ``model.dt`` as ``cut`` times as many of ``model.dt / cut`` (the same
-    compiled program: the step is a leaf of the model). The integrator's time is its step count
+    compiled program: :func:`rescaled`). The integrator's time is its step count
     times its step, so the count runs in cut steps inside and in the run's steps outside (the
     chunk ends on a whole step of the run; a failing step is reported as the run's step it falls in)."""
     if cut == 1:
         return _advance_jit(model, state, e0, x_ref, n_sub, floor)
-    fine = dataclasses.replace(model, dt=model.dt / cut)
+    fine = rescaled(model, step=1.0 / cut)
     new = _advance_jit(fine, dataclasses.replace(state, step=state.step * cut), e0, x_ref, n_sub * cut, floor)
     bad = jnp.where(new.bad_step >= 0, new.bad_step // cut, new.bad_step)
     return dataclasses.replace(new, step=new.step // cut, bad_step=bad)
 
 
-def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo, cut: int = 1):
+def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo, cut: int = 1,
+           stiffen_above: float = np.inf):
     """One host chunk of ``n_sub`` steps from ``state`` (with the step cut to ``1/cut``):
     ``(new_state, fields)``, or :class:`~jaxform.integrate.SimulationError` when a step failed
-    or the run left its bounds."""
+    or the run left its bounds (``stiffen_above``: :func:`physical_causes`)."""
     new = _cut_advance(model, state, e0, x_ref, n_sub, floor, cut)
     if int(new.bad_step) >= 0:
         raise integrate.SimulationError(
@@ -228,7 +256,7 @@ def _chunk(model, state, e0, x_ref, n_sub, floor, ply_arr, info: RunInfo, cut: i
             step=int(new.bad_step), time=int(new.bad_step) * info.dt, cause=integrate.failure_cause(new),
             frames=_single_frame(new), state=new)
     fl = fields_jit(model, new, ply_arr, n_plies=info.case.n_plies)
-    _check_health(new, fl, info, state)
+    _check_health(new, fl, info, state, stiffen_above)
     return new, fl
 
 
@@ -244,19 +272,64 @@ def with_momentum_term(model):
 @dataclasses.dataclass
 class Standing:
     """Where a host run stands: the model running, the last good state, and where the driver
-    switched the fibre mass's momentum term on (``FormingResult.momentum_term_from``). Kept
-    current by :func:`drive`, so that a run that raises still has its last good state."""
+    switched the fibre mass's momentum term on (``FormingResult.momentum_term_from``) and cut the
+    step (``cuts``). Kept current by :func:`drive`, so that a run that raises still has its last
+    good state. ``may_cut``: the step was chosen automatically; ``may_stiffen``: so was the
+    contact's stiffness (:meth:`of`)."""
 
     model: Any
     state: Any
     switched: dict | None = None
     may_cut: bool = True
+    may_stiffen: bool = False
     cuts: list = dataclasses.field(default_factory=list)
+    applied: float = 1.0
+    armed: bool = True
+
+    @classmethod
+    def of(cls, model, state, info: RunInfo) -> "Standing":
+        """A run's start: what the driver may change follows from what the user gave (a step is
+        never cut, nor a penalty stiffness raised, where the user gave it)."""
+        return cls(model, state, may_cut=may_cut_step(info), may_stiffen=may_stiffen_contact(info))
 
     @property
     def cut(self) -> int:
         """The step runs at the run's over this (1 until :meth:`recover` cuts it)."""
         return self.cuts[-1]["cut"] if self.cuts else 1
+
+    @property
+    def stiffness(self) -> float:
+        """The contacts' penalty goes to the run's times this (1 until :meth:`recover` stiffens it;
+        ``applied``: where it is, :meth:`ramp`)."""
+        return self.cuts[-1]["contact_stiffness"] if self.cuts else 1.0
+
+    def ramp(self) -> None:
+        """Before a chunk: the contact a factor of at most :data:`~jaxform.forming.numerics.CONTACT_RAMP`
+        closer to :attr:`stiffness` (a stiffer contact at once kicks the nodes it holds: 4x on a node
+        pressed 0.1 mm deep sends it off at about ``0.75 omega delta``: metres per second at 8 mm, by estimate)."""
+        if self.applied < self.stiffness * (1.0 - 1e-9):
+            f = min(self.stiffness / self.applied, CONTACT_RAMP)
+            self.model, self.applied = rescaled(self.model, stiffness=f), self.applied * f
+
+    @property
+    def can_stiffen(self) -> bool:
+        """Whether :meth:`recover` may still stiffen the contact (and halve the step with it)."""
+        return self.may_stiffen and self.cut < MAX_STEP_CUT
+
+    def stiffen_above(self, rec: "Recorder") -> float:
+        """m: the next chunk counts a penetration beyond ``stiffen_penetration`` as a cause where
+        it is also deeper than this (:func:`physical_causes`): the penetration at the chunk's start
+        (a growing one), where the contact can still be stiffened; else ``inf``. After a
+        stiffening, not before the contact has reached its new stiffness (:meth:`ramp`) and the
+        penetration has healed below the bound (:meth:`accept`: a stiffer contact takes a few of
+        its periods to push the nodes out, and the chunks meanwhile would stiffen it again)."""
+        return rec.hist["max_penetration_m"][-1] if self.can_stiffen and self.armed else np.inf
+
+    def accept(self, new, fl, bounds) -> None:
+        """A chunk ended well in ``new`` (its fields ``fl``): it is where the run stands."""
+        self.state = new
+        settled = self.applied >= self.stiffness * (1.0 - 1e-9) and float(fl["max_penetration"]) <= bounds.stiffen_penetration
+        self.armed = self.armed or settled
 
     def _where(self, rec: "Recorder", cause: str) -> dict:
         return {"step": int(self.state.step), "t_s": float(self.state.t),
@@ -274,13 +347,26 @@ class Standing:
 
     def recover(self, rec: "Recorder", cause: str) -> bool:
         """What to change before the chunk that failed with ``cause`` runs again from the last
-        good state: the momentum term (:meth:`switch`), else half the step (down to
-        1/:data:`MAX_STEP_CUT`, an automatic step only); False where nothing is left to change."""
+        good state; False where nothing is left to change. A penetration (:func:`penetrated`):
+        half the step, and the contact on its way to :data:`~jaxform.forming.numerics.CONTACT_STIFFEN`
+        times as stiff (:meth:`ramp`; at once beyond half the ply), an automatic contact only: a
+        step cut alone never helps there. Else: the momentum
+        term (:meth:`switch`), else half the step (down to 1/:data:`MAX_STEP_CUT`, an automatic
+        step only)."""
+        if penetrated(cause):
+            if not self.can_stiffen:
+                return False
+            self.cuts.append({**self._where(rec, cause), "cut": 2 * self.cut,
+                              "contact_stiffness": CONTACT_STIFFEN * self.stiffness})
+            self.armed = False
+            if DEEPER not in cause:  # beyond half the ply: at once (the chunk failed; ramp() otherwise)
+                self.model, self.applied = rescaled(self.model, stiffness=self.stiffness / self.applied), self.stiffness
+            return True
         if self.switch(rec, cause):
             return True
         if not self.may_cut or self.cut >= MAX_STEP_CUT:
             return False
-        self.cuts.append({**self._where(rec, cause), "cut": 2 * self.cut})
+        self.cuts.append({**self._where(rec, cause), "cut": 2 * self.cut, "contact_stiffness": self.stiffness})
         return True
 
 
@@ -297,8 +383,10 @@ def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progres
     n_sub = jnp.asarray(info.sub_steps, jnp.int32)
     for c in range(int(at.state.step) // info.sub_steps, (info.n_frames - 1) * info.samples_per_frame):
         while True:
+            at.ramp()
             try:
-                new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info, at.cut)
+                new, fl = _chunk(at.model, at.state, e0, x_ref, n_sub, floor, ply_arr, info, at.cut,
+                                 at.stiffen_above(rec))
                 break
             except integrate.SimulationError as err:
                 if not at.recover(rec, err.cause):
@@ -307,7 +395,7 @@ def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progres
                             f"{err} It failed also with the step cut to 1/{at.cut}.", step=err.step, time=err.time,
                             cause=err.cause, frames=err.frames, state=err.state) from err
                     raise
-        at.state = new
+        at.accept(new, fl, info.bounds)
         rec.sample(new, fl)
         if on_progress is not None:
             on_progress(int(new.step), info.n_steps, float(new.t), float(fl["punch_displacement"]),
@@ -321,20 +409,21 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     """Run a built rig on the host, chunk by chunk (``info.sub_steps`` steps per jitted call).
 
     A chunk that fails (a step, or the run's bounds) is run again from its start, as often as
-    :meth:`Standing.recover` finds something to change. With a fibre mass but not its momentum
-    term, first with the term, and so is the rest of the run
-    (``momentum_term_from`` of the result, ``numerics.fibre_mass_momentum_term_choice`` of the
-    summary). Without the term the position-dependent mass can pump energy into elements that
-    turn fast (a whipping corner, a snapping wrinkle) within a few hundred steps; the term removes
-    that at about twice a step's cost, so it is paid only from where it was needed. Measured:
-    woven Case A LBM B_inf, 4 mm, blew up at 90 % of the stroke within one chunk (the energy
-    residual was 0.3 % of the largest energy at the chunk's start). Then, where the step was
-    chosen automatically (:func:`may_cut_step`), with half the step, then a quarter, then an
-    eighth (:data:`MAX_STEP_CUT`): the chunk's steps are run as two, four or eight steps each, and
-    so are the rest of the run's (``step_cuts`` of the result, ``numerics.step_cuts`` of the
-    summary). Why: ``case-a-ncf-nlbm`` at 4 mm and the quasi-static 31.25 mm/s blew up at
-    95 % of the stroke after a sudden event (node speeds 0.8 -> 7.9 m/s at a 0.031 m/s punch); a
-    step chosen for the quasi-static run need not hold through a snap.
+    :meth:`Standing.recover` finds something to change (the README's modelling choices tell the
+    runs that made each remedy needed). With a fibre mass but not its momentum term: with the
+    term from there (``momentum_term_from`` of the result; without it the position-dependent mass
+    can pump energy into elements that turn fast; the term costs about a step's cost again, so it
+    is paid only from where it is needed). Where the step was chosen automatically
+    (:func:`may_cut_step`): with half the step, then a quarter, then an eighth
+    (:data:`MAX_STEP_CUT`; a snap-through is not the quasi-static run the step was chosen for),
+    the rest of the run too (``step_cuts`` of the result, ``numerics.step_cuts`` of the summary).
+    A node deeper in a tool or ply than :data:`~jaxform.forming.numerics.STIFFEN_PENETRATION` of
+    the ply at a chunk's end, and deeper than at its start, where the contact's stiffness was
+    chosen automatically (:func:`may_stiffen_contact`): the chunk again with half the step, and
+    the contact :data:`~jaxform.forming.numerics.CONTACT_STIFFEN` times as stiff over the next 8
+    chunks (:meth:`Standing.ramp`; at once beyond half the ply), not again before the
+    penetration has healed (the automatic contact is chosen for an expected pressure; the fabric
+    decides the real one: NCF Case A presses the die's entry radius with 23-46 kPa at 8 mm).
 
     Args:
         rig: :func:`jaxform.forming.build`'s ``(model, state, info)``.
@@ -349,7 +438,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     """
     t_wall = time.perf_counter()
     model, state, info = rig
-    at = Standing(model, state, may_cut=may_cut_step(info))
+    at = Standing.of(model, state, info)
     rec = Recorder(on_frame)
     complete, reason = False, None
     try:
@@ -387,6 +476,13 @@ def may_cut_step(info: RunInfo) -> bool:
     return getattr(getattr(info, "numerics", None), "governed_by", None) != "user"
 
 
+def may_stiffen_contact(info: RunInfo) -> bool:
+    """Whether the driver may stiffen the run's contact (:meth:`Standing.recover`): not where the
+    user gave the step or the penalty stiffness (a given ``contact.safety`` is kept: the stiffness
+    grows as the step shrinks)."""
+    return may_cut_step(info) and info.case.contact.penalty_stiffness is None
+
+
 def simulate(case: Case, *, dtype=None, element_size: float | None = None, overrides=(),
              on_frame: Callable | None = None, on_progress: Callable | None = None, catch: bool = False, fabric=None,
              samples_per_frame: int | None = None, damping: float = 0.0, dt: float | None = None,
@@ -420,5 +516,5 @@ def simulate(case: Case, *, dtype=None, element_size: float | None = None, overr
     return result
 
 
-__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "MAX_STEP_CUT", "may_cut_step", "run_steps", "rollout", "FormingResult", "Standing", "drive", "with_momentum_term", "run", "simulate", "physical_causes",
-           "out_of_bounds_message"]
+__all__ = ["BLOWUP_TOL", "ENERGY_FLOOR", "MAX_STEP_CUT", "may_cut_step", "may_stiffen_contact", "run_steps", "rollout", "FormingResult", "Standing", "drive", "with_momentum_term", "run", "simulate", "physical_causes",
+           "out_of_bounds_message", "PENETRATED", "penetrated", "rescaled"]

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from jaxform.contact import EXPECTED_PRESSURE, MAX_PENETRATION
+from jaxform.penalty import EXPECTED_PRESSURE, MAX_PENETRATION
 from jaxform.forming.case import Case
 from jaxform.forming.speed import along_edges
 from jaxform.shell import Shell, _ply_frequencies
@@ -73,6 +73,22 @@ the tools then press the fabric only with its own tension and bending. Largest n
 pressure over the frames of Case A at 62.5 mm/s: woven NLBM 1.7 kPa at 8 mm, 0.91 kPa at 4 mm;
 woven LBM B_inf 3.2 kPa at 4 mm. A run that exceeds it is seen: its deepest penetration is
 recorded, and beyond half the ply it stops (:func:`jaxform.forming.rig.health_bounds`)."""
+
+STIFFEN_PENETRATION = 0.25
+"""A fraction of the ply thickness: where a node of a run with an automatic contact penetrates a
+tool or ply deeper than this (2.5 times what the contact is chosen for at its expected pressure),
+the run's pressures exceed that expectation and the driver stiffens the contact
+(:data:`CONTACT_STIFFEN`, :meth:`jaxform.forming.driver.Standing.recover`). Measured at 8 mm and
+the automatic speeds: every NCF Case A preset went beyond (0.31-0.50 h; 23-46 kPa on the die's
+entry radius, where the +-45 deg fibres are drawn over it in tension, against 0.4 kPa woven),
+Case B NCF to 0.45 h (0.46 MPa there, against its 0.1 MPa); woven Case A stays below 0.08 h."""
+CONTACT_STIFFEN = 4.0
+"""The factor by which the driver stiffens an automatic contact each time (with the step halved:
+``k dt^2``, the contact's share of the step budget, stays, so the step stays as stable as it was)."""
+CONTACT_RAMP = CONTACT_STIFFEN ** (1.0 / 8.0)
+"""The most the driver stiffens the contact from one chunk to the next (so 8 chunks to
+:data:`CONTACT_STIFFEN`): a node held at a penetration ``delta`` is kicked off at about
+``omega delta (1 - 1/f)`` by a contact ``f`` times as stiff at once."""
 
 
 def expected_pressure(case: Case) -> tuple[float, str]:
@@ -170,4 +186,4 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
 
 
 __all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
-           "AUTO_SAFETY", "GAP_EXPECTED_PRESSURE", "expected_pressure", "ContactNumerics", "contact_numerics"]
+           "AUTO_SAFETY", "GAP_EXPECTED_PRESSURE", "STIFFEN_PENETRATION", "CONTACT_STIFFEN", "CONTACT_RAMP", "expected_pressure", "ContactNumerics", "contact_numerics"]

@@ -37,9 +37,9 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxform import contact, integrate, units
+from jaxform import contact, integrate, penalty, units
 from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
-from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNumerics, auto_fibre_mass,
+from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, STIFFEN_PENETRATION, ContactNumerics, auto_fibre_mass,
                                       contact_numerics, expected_pressure)
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
@@ -103,7 +103,8 @@ class HealthBounds:
         fibre_strain: largest ``|fibre strain|`` of any element (the fibres' 3 GPa modulus keeps
             real strains below 1%); speed: largest node speed, m/s; box_lo, box_hi: (3,) corners
             of the box the part stays in, m; penetration: deepest penetration of a node into a
-            tool or ply, m.
+            tool or ply, m; stiffen_penetration: the penetration beyond which an automatic contact
+            is stiffened (:data:`jaxform.forming.numerics.STIFFEN_PENETRATION`), m.
     """
 
     fibre_strain: float
@@ -111,6 +112,7 @@ class HealthBounds:
     box_lo: tuple
     box_hi: tuple
     penetration: float = math.inf
+    stiffen_penetration: float = math.inf
 
 
 def health_bounds(case: Case) -> HealthBounds:
@@ -119,14 +121,16 @@ def health_bounds(case: Case) -> HealthBounds:
     stays well below), and a box of twice the blank's half-size across, from the punch's lowest
     reach minus a blank half-size below to the holder's top plus a blank half-size above; a
     penetration of half the ply thickness (five times what the automatic contact allows at its
-    expected pressure: the pressures exceed it and the contact is too soft)."""
+    expected pressure: the pressures exceed it and the contact is too soft), and beyond
+    :data:`~jaxform.forming.numerics.STIFFEN_PENETRATION` of it the automatic contact stiffens."""
     half = 0.5 * case.blank_size
     t = case.tools
     top = (case.holder.gap or case.stack_thickness) + t.holder_thickness + half
     bottom = -(case.process.stroke + t.die_thickness + half)
     return HealthBounds(fibre_strain=0.1, speed=max(100.0 * case.process.speed, 10.0),
                         box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top),
-                        penetration=0.5 * float(case.ply_thickness))
+                        penetration=0.5 * float(case.ply_thickness),
+                        stiffen_penetration=STIFFEN_PENETRATION * float(case.ply_thickness))
 
 
 class Rig(NamedTuple):
@@ -296,10 +300,10 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
                   expected_pressure=expected_pressure(case)[0],
                   damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=n_if)
-    params_tool = contact.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
-    params_ply = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
+    params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
+    params_ply = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
     common["interfaces"] = n_if + 1  # a folded node: tools or plies, and a layer of itself
-    params_self = contact.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
+    params_self = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
 
     area = np.asarray(mesh.node_area, np.float64)
     ply_id = _ply_ids(mesh)

@@ -7,7 +7,7 @@ import math
 import jax
 import numpy as np
 
-from jaxform.contact import MAX_PENETRATION
+from jaxform.penalty import MAX_PENETRATION
 from jaxform.forming.case import to_dict
 from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS
 from jaxform.forming.numerics import expected_pressure
@@ -68,7 +68,7 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
 def _step_choice(info, history) -> dict:
     """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`),
     and the deepest penetration the run's samples saw, as a fraction of the ply thickness (the
-    automatic contact keeps it below :data:`jaxform.contact.MAX_PENETRATION` at the expected pressure)."""
+    automatic contact keeps it below :data:`jaxform.penalty.MAX_PENETRATION` at the expected pressure)."""
     n = getattr(info, "numerics", None)
     if n is None:
         return {}
@@ -97,9 +97,12 @@ def _momentum_term(result) -> dict:
 
 def _step_cuts(result) -> dict:
     """Where the driver cut the step (:data:`jaxform.forming.driver.MAX_STEP_CUT`; a cut stays, so
-    at most three): ``step_cuts`` (step, time, punch, cut, cause each) and the step the run ended with."""
+    at most three): ``step_cuts`` (step, time, punch, cut, contact_stiffness, cause each), the
+    step the run ended with, and the factor its contacts' penalty ended with (the driver stiffens
+    an automatic contact, with a cut, where a node penetrated too deep)."""
     cuts = [dict(c) for c in getattr(result, "step_cuts", None) or []]
-    return {"step_cuts": cuts, "smallest_dt_s": result.info.dt / (cuts[-1]["cut"] if cuts else 1)}
+    return {"step_cuts": cuts, "smallest_dt_s": result.info.dt / (cuts[-1]["cut"] if cuts else 1),
+            "contact_stiffness_factor": cuts[-1]["contact_stiffness"] if cuts else 1.0}
 
 
 def summarize(result) -> dict:

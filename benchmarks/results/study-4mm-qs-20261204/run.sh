@@ -18,3 +18,11 @@ start=$(date +%s)
 .venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --only case-a-ncf --bending membrane > .git/study/qs4-ncf-membrane.log 2>&1
 echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-ncf-membrane.log
 .venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --analyse-only > .git/study/qs4-analyse3.log 2>&1
+# Added on 2026-12-05 (the session after, at 3663a31's code: the step cut and the adaptive contact): NCF NLBM again
+# alone (the failed run of 2026-12-04 moved out of runs/ first, since the study reuses a run folder),
+# then the report again over every run in the folder.
+mv .git/study/qs4/runs/case-a-ncf-nlbm .git/study/qs4-failed-case-a-ncf-nlbm-20261204
+start=$(date +%s)
+.venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --only case-a-ncf --bending nlbm > .git/study/qs4-ncf-nlbm2.log 2>&1
+echo "rc=$? wall=$(( $(date +%s)-start ))s" >> .git/study/qs4-ncf-nlbm2.log
+.venv/bin/jaxform study paper --out .git/study/qs4 --element-size-mm 4 --analyse-only > .git/study/qs4-analyse4.log 2>&1

@@ -32,6 +32,9 @@ Friction (regularised Coulomb)
     holds the summed ratio at 1: more creep under high pressure and large steps, never an
     unstable stick (an 8 mm Case B stack blew up with the per-interface limit alone).
 
+Friction against the rigid tools is integrated backward by the integrator (:class:`ToolLoad`,
+:mod:`jaxform.friction`), with the plain ``eps_v`` and no stick limit.
+
 The automatic penalty stiffness and its checks: :mod:`jaxform.penalty`.
 
 The blank holder under force control is a 1-DOF rigid body (:func:`holder_step`) advanced with
@@ -39,12 +42,14 @@ the same central-difference (leapfrog) scheme as the fabric.
 """
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import jax
 import jax.numpy as jnp
 
 from jaxform import broadphase, tools, validate
+from jaxform.friction import backward_friction, regularised_friction
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
@@ -126,14 +131,6 @@ def penetration(g, width):
     energy = jnp.where(deep, w * w / 6.0 + 0.5 * (p * p - w * w) - 0.5 * w * (p - w),
                        jnp.where(ramp, p**3 / (6.0 * ws), 0.0))
     return delta, energy
-
-
-def regularised_friction(v_t, normal_force, mu, eps_v):
-    """Regularised Coulomb force (3,), N, for slip velocity ``v_t`` (3,) m/s and ``F_n`` >= 0 (N).
-
-    ``-mu F_n v_t / sqrt(|v_t|^2 + eps_v^2)``: magnitude below ``mu F_n``, smooth at zero slip.
-    """
-    return -mu * normal_force * v_t / jnp.sqrt(jnp.sum(v_t * v_t) + eps_v * eps_v)
 
 
 def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
@@ -354,6 +351,9 @@ class ToolLoad:
         active: (N,) 0/1 weights of the nodes that may touch this tool (ones for a single ply).
         clamp_force, mass, damping, dt: holder control (N, kg, N·s/m, s); unused when prescribed.
         force_controlled: static.
+        implicit_friction: static; ``True`` (default): ``force`` returns the normal force and the
+            integrator adds the friction through :meth:`friction` (:func:`backward_friction`);
+            ``False``: the explicit law with ``params.stick_limit``, inside ``force``.
     """
 
     tool: Any
@@ -366,6 +366,14 @@ class ToolLoad:
     damping: Any = 0.0
     dt: Any = 0.0
     force_controlled: bool = static_field(default=False)
+    implicit_friction: bool = static_field(default=True)
+
+    @property
+    def law(self) -> ContactParams:
+        """The parameters whose law, at a node's velocity after a step, gives the force this load
+        applied in it (:func:`tool_contact` of a frame): with the implicit friction, the plain
+        regularisation (no stick limit)."""
+        return dataclasses.replace(self.params, stick_limit=0.0) if self.implicit_friction else self.params
 
     def gap(self, x, t, load_state):
         """(N,) the gap of each node's contacting face to the tool at time ``t``, m (``inf`` for nodes
@@ -381,7 +389,8 @@ class ToolLoad:
             vel = jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
         else:
             dz, vel = tool_pose(self.tool, t)
-        res = tool_contact(self.tool, x, v, self.offset, self.area, self.params, dz=dz, tool_velocity=vel,
+        params = dataclasses.replace(self.params, friction=0.0) if self.implicit_friction else self.params
+        res = tool_contact(self.tool, x, v, self.offset, self.area, params, dz=dz, tool_velocity=vel,
                            active=self.active)
         new = load_state
         if self.force_controlled:
@@ -389,7 +398,18 @@ class ToolLoad:
                               damping=self.damping)
         extras = {"reaction": res.reaction, "dz": jnp.asarray(dz), "contact_energy": res.energy,
                   "friction_power": res.friction_power, "max_pressure": jnp.max(res.pressure)}
+        if self.implicit_friction:
+            extras["friction_support"] = (res.force, vel)
         return res.force, new, extras
+
+    def friction(self, support, p, mass, h, extras):
+        """The friction of this step (the integrator's hook, :mod:`jaxform.model`): ``(force (N, 3) N,
+        extras)`` for the trial momentum ``p`` (N, 3), lumped ``mass`` (N,) and step ``h``, from the
+        ``support`` that :meth:`force` returned (:func:`backward_friction`); the extras' reaction
+        and friction power then include it."""
+        f_normal, vel = support
+        f, pw = backward_friction(p, mass, h, f_normal, self.params.friction, self.params.slip_velocity, vel)
+        return f, dict(extras, reaction=extras["reaction"] - jnp.sum(f, axis=0), friction_power=jnp.sum(pw))
 
 
 @pytree_dataclass
@@ -444,5 +464,5 @@ class PlyLoad:
 
 
 __all__ = ["ContactParams", "ContactResult", "HolderState", "penetration",
-           "regularised_friction", "node_contact", "tool_contact", "tool_pose", "ply_contact", "nearest_faces",
+           "node_contact", "tool_contact", "tool_pose", "ply_contact", "nearest_faces",
            "quads_to_triangles", "holder_step", "ToolLoad", "PlyLoad"]

@@ -161,9 +161,11 @@ def _step(model: Model, state: State, x_ref):
     f_grav = m * model.gravity[:, None]
     f_damp = -model.damping * m * vs_old
     f_loads = jnp.zeros_like(xs)
-    new_loads, extras = [], []
+    new_loads, extras, supports = [], [], []
     for load, ls in zip(model.loads, state.loads):
         f, ls_new, ex = load.force(x, v_old, t, ls)
+        ex = dict(ex)
+        supports.append(ex.pop("friction_support", None))
         f_loads = f_loads + f.T
         new_loads.append(ls_new)
         extras.append(ex)
@@ -176,6 +178,12 @@ def _step(model: Model, state: State, x_ref):
     # on the first step the initial velocity is the full-step velocity: advance half a step
     h = jnp.where(first, 0.5 * dt, dt)
     p_new = free * (state.momentum + h * f_free)
+    for i, (load, sup) in enumerate(zip(model.loads, supports)):  # friction integrated backward (model.py)
+        if sup is not None:
+            f_fr, extras[i] = load.friction(sup, p_new.T, model.mass, h, extras[i])
+            f_fr = free * f_fr.T
+            p_new = p_new + h * f_fr
+            f_loads = f_loads + f_fr
     if fm is None:
         v_free = p_new / m
     else:

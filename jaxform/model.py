@@ -19,6 +19,17 @@ of small arrays (contact force, tool position...) saved in every frame under
 ``frames.extras[i]``. The integrator adds ``f`` to the internal, gravity and damping forces and
 books its work as external work. A load must be a pure function of its arguments.
 
+Friction integrated backward (optional): a load whose ``extras`` hold a ``"friction_support"``
+entry (taken out of the extras by the integrator) also has a method::
+
+    load.friction(support, p, mass, h, extras) -> (f, extras)
+
+called once every load's force is in, in ``Model.loads`` order, with ``p`` (N, 3) the trial
+momentum at the end of the step (all other forces, and the friction of the loads before it,
+applied), ``mass`` (N,) the lumped masses and ``h`` the step: ``f`` (N, 3) the friction force it
+adds (booked as external work with the load's force) and the load's extras updated with it
+(:class:`jaxform.contact.ToolLoad`: its reaction and friction power).
+
 Prescribed motion: ``Model.fixed`` (N, 3) bool marks the degrees of freedom that are driven;
 their positions follow ``Model.drive.position(t)`` (any pytree with that method; the default
 :class:`Hold` keeps them at their initial positions, :class:`LinearDrive` moves them at constant

@@ -6,7 +6,7 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform import contact, penalty, tools
+from jaxform import contact, friction, penalty, tools
 
 H = 0.3e-3  # ply thickness, m
 RHO_A = 0.21  # kg/m²
@@ -77,7 +77,7 @@ def test_smooth_penetration_is_c1_and_matches_plain_beyond_width():
 
 def test_friction_saturates_at_mu_n_and_is_smooth_at_zero_slip():
     mu, eps, fn = 0.23, 1e-3, 2.0
-    f = lambda vt: contact.regularised_friction(vt, fn, mu, eps)
+    f = lambda vt: friction.regularised_friction(vt, fn, mu, eps)
     big = f(jnp.array([1.0, 0.0, 0.0]))
     np.testing.assert_allclose(big, [-mu * fn * 1.0 / math.sqrt(1 + eps**2), 0, 0], rtol=1e-12)
     assert abs(float(big[0]) + mu * fn) < 1e-6 * mu * fn  # Coulomb within 1e-6 at 1000 eps
@@ -309,3 +309,40 @@ def test_stick_under_high_pressure_is_stable_with_the_stick_limit():
     assert flips >= 20 and abs(out["plain"][-1]) > 1e-5  # the test sees chatter where it exists
     # two-sided (ply on ply) contact: twice the limit (two nodes share the slip)
     assert float(penalty.contact_params(RHO_A, dt, H, two_sided=True).stick_limit) == pytest.approx(2 * dt / RHO_A)
+
+
+def test_backward_friction_solves_the_regularised_law_at_the_end_of_step_slip():
+    """:func:`friction.backward_friction` against an independent root finder (scipy's brentq on
+    ``m (u* - u) / h = mu F_n u / sqrt(u**2 + eps**2)``), against Coulomb's return mapping as
+    ``eps -> 0``, and its gradient against central differences (float64)."""
+    from scipy.optimize import brentq
+
+    m, h, mu, fn, eps = 2e-5, 1e-5, 0.23, 1e-2, 1e-4
+    a = h * mu * fn / m  # the slip speed friction can remove in one step: 1.15e-3 m/s
+    speeds = a * np.array([0.0, 0.01, 0.5, 0.9, 0.999, 1.0, 1.001, 1.1, 3.0, 100.0])
+    n = len(speeds)
+    tool_v = np.array([0.02, 0.0, 0.0])  # a moving tool: the slip is relative to it
+    direction = np.array([0.6, 0.8, 0.0])
+    p = m * (tool_v + speeds[:, None] * direction + np.array([0.0, 0.0, 0.3]))  # a normal part too
+    f_normal = np.tile([0.0, 0.0, fn], (n, 1))
+    f, pw = jax.jit(friction.backward_friction)(p, np.full(n, m), h, f_normal, mu, eps, tool_v)
+    f, pw = np.asarray(f), np.asarray(pw)
+    for us, fi, pi in zip(speeds, f, pw):
+        u = brentq(lambda u: u + a * u / math.hypot(u, eps) - us, 0.0, us) if us > 0 else 0.0
+        mag = mu * fn * u / math.hypot(u, eps)
+        np.testing.assert_allclose(fi, -mag * direction, rtol=1e-6, atol=1e-9 * mu * fn)
+        assert pi == pytest.approx(mag * u, rel=1e-5, abs=1e-12)
+        assert np.linalg.norm(fi) <= mu * fn * (1 + 1e-12)  # never beyond Coulomb
+        assert u <= us  # never reverses the slip
+    # eps << a: Coulomb's return mapping (stick below a, mu F_n beyond)
+    f0, _ = friction.backward_friction(p, np.full(n, m), h, f_normal, mu, 1e-5 * a, tool_v)
+    coulomb = -np.minimum(speeds / a, 1.0)[:, None] * mu * fn * direction
+    np.testing.assert_allclose(np.asarray(f0), coulomb, atol=1e-3 * mu * fn)
+    # d force / d momentum, AD against central differences, in stick and in slip
+    fx = lambda q: friction.backward_friction(q, np.full(n, m), h, f_normal, mu, eps, tool_v)[0][:, 0]  # noqa: E731
+    g = np.asarray(jax.jacfwd(fx)(jnp.asarray(p)))[np.arange(n), np.arange(n), 0]
+    d = 1e-6 * m * eps
+    dp = np.zeros_like(p)
+    dp[:, 0] = d
+    fd = (np.asarray(fx(p + dp)) - np.asarray(fx(p - dp))) / (2 * d)
+    np.testing.assert_allclose(g[1:], fd[1:], rtol=1e-5)

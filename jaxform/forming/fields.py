@@ -88,7 +88,7 @@ def state_fields(model, state, ply_id, n_plies: int):
     pen = jnp.zeros((), dtype)
     for i, (load, ls) in enumerate(zip(model.loads[:3], state.loads[:3])):
         dz, vel = _tool_pose(load, state.t, ls)
-        res = contact.tool_contact(load.tool, x, state.v, load.offset, load.area, load.params, dz=dz,
+        res = contact.tool_contact(load.tool, x, state.v, load.offset, load.area, load.law, dz=dz,
                                    tool_velocity=vel, active=load.active)
         pressure = pressure + res.pressure
         pen = jnp.maximum(pen, jnp.max(jnp.where(jnp.asarray(load.active) > 0, -res.gap, 0.0)))

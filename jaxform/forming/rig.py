@@ -296,11 +296,13 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     rho = float(np.max(np.asarray(fab0.areal_mass))) * float(case.mass_scaling)
     c = case.contact
     speed = float(case.process.speed)
-    n_if = 2 if case.n_plies > 1 else 1  # frictional contacts per node (stack: tool + ply, or two plies)
+    # explicit frictional contacts per node (the tools' friction is implicit: ToolLoad.friction):
+    # one other ply in a pair, two for a middle ply
+    n_if = min(case.n_plies - 1, 2)
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
                   expected_pressure=expected_pressure(case)[0],
                   damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=n_if)
-    params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
+    params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **dict(common, interfaces=0))
     params_ply = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
     common["interfaces"] = n_if + 1  # a folded node: tools or plies, and a layer of itself
     params_self = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)

@@ -22,8 +22,8 @@ Friction (regularised Coulomb)
     (``-mu F_n / eps_v``). The price is creep: a node held by a tangential load ``F < mu F_n``
     slides at ``v = eps_v r / sqrt(1 - r**2)``, ``r = F / (mu F_n)``. Choose ``eps_v`` small
     against the process speed (``jaxform.cases`` uses 1% of the punch speed).
-    In stick that slope acts on the node as a viscous damper ``c = mu p A / eps_v``, integrated
-    explicitly: stable only while ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent
+    In stick that slope acts on the node as a viscous damper ``c = mu p A / eps_v``. Integrated
+    explicitly (``implicit_friction=False`` and the self-contact), it is stable only while ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent
     of the mesh). Under a clamped holder (Case B, ~15 kPa) with a 1% regularisation that ratio
     reached 5-8 and the tangential velocity flipped sign every step (chatter, then a blow-up).
     So ``eps_v`` is raised where needed to ``mu p * stick_limit`` with ``stick_limit = n dt /
@@ -32,8 +32,9 @@ Friction (regularised Coulomb)
     holds the summed ratio at 1: more creep under high pressure and large steps, never an
     unstable stick (an 8 mm Case B stack blew up with the per-interface limit alone).
 
-Friction against the rigid tools is integrated backward by the integrator (:class:`ToolLoad`,
-:mod:`jaxform.friction`), with the plain ``eps_v`` and no stick limit.
+The tools' and the plies' friction is integrated backward by default (:class:`ToolLoad`,
+:class:`PlyLoad`, :mod:`jaxform.friction`), with the plain ``eps_v`` and no stick limit: the raised
+``eps_v`` gave far less than Coulomb under a clamping pressure.
 
 The automatic penalty stiffness and its checks: :mod:`jaxform.penalty`.
 
@@ -49,7 +50,7 @@ import jax
 import jax.numpy as jnp
 
 from jaxform import broadphase, tools, validate
-from jaxform.friction import backward_friction, regularised_friction
+from jaxform.friction import backward_friction, backward_pair_friction, regularised_friction
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
@@ -244,7 +245,7 @@ def _ply_node(p, vp, tri_x, tri_v, side, gap0, area, params):
     return force, w[j], j, pressure, g, e, pw
 
 
-def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactParams) -> ContactResult:
+def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactParams, *, pairs: bool = False):
     """Node-to-surface contact between two plies of a stack, with friction.
 
     Each slave node (of the upper ply) is tested against its candidate triangles of the master
@@ -269,7 +270,8 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
         params: :class:`ContactParams` (``friction`` 0.36 fabric–fabric).
 
     Returns:
-        :class:`ContactResult` with ``force`` (N, 3) on all nodes, ``pressure``/``gap`` (N_s,).
+        :class:`ContactResult` with ``force`` (N, 3) on all nodes, ``pressure``/``gap`` (N_s,); with
+        ``pairs``, also ``(f (N_s, 3) on each slave, master_nodes (N_s, 3) int, weights (N_s, 3))``.
     """
     x, v = jnp.asarray(x), jnp.asarray(v)
     slave = jnp.asarray(slave)
@@ -283,10 +285,16 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
         x[slave], v[slave], x[tri_c], v[tri_c], side, jnp.asarray(gap0, x.dtype), area, params
     )
     master_nodes = jnp.take_along_axis(tri_c, j[:, None, None], axis=1)[:, 0, :]  # (N_s, 3)
+    res = ContactResult(force=pair_forces(x, slave, master_nodes, w, f), reaction=jnp.zeros(3, x.dtype), pressure=p,
+                        gap=g, energy=jnp.sum(e), friction_power=jnp.sum(pw))
+    return (res, (f, master_nodes, w)) if pairs else res
+
+
+def pair_forces(x, slave, master_nodes, w, f):
+    """(N, 3) nodal forces of slave–surface pairs: ``f`` (N_s, 3) on each slave node, ``-w f`` on
+    its master triangle's nodes ``master_nodes`` (N_s, 3) with the barycentric weights ``w``."""
     force = jnp.zeros_like(x).at[slave].add(f)
-    force = force.at[master_nodes.reshape(-1)].add((-w[:, :, None] * f[:, None, :]).reshape(-1, 3))
-    return ContactResult(force=force, reaction=jnp.zeros(3, x.dtype), pressure=p, gap=g, energy=jnp.sum(e),
-                         friction_power=jnp.sum(pw))
+    return force.at[master_nodes.reshape(-1)].add((-w[:, :, None] * f[:, None, :]).reshape(-1, 3))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -425,6 +433,9 @@ class PlyLoad:
         slave: (N_s,) int; triangles: (F, 3) int; gap0: () m; area: () or (N_s,) m²;
         params: :class:`ContactParams`; skin: () m (default ``gap0``);
         k, refresh_every, cap (triangles read per grid cell and page): static ints.
+        implicit_friction: static; ``True`` (default): the friction is integrated backward
+            (:meth:`friction`, :func:`jaxform.friction.backward_pair_friction`); ``False``: the
+            explicit law with ``params.stick_limit``.
     """
 
     slave: Any
@@ -436,6 +447,7 @@ class PlyLoad:
     k: int = static_field(default=8)
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=8)
+    implicit_friction: bool = static_field(default=True)
 
     def _skin(self):
         return self.gap0 if self.skin is None else self.skin
@@ -457,10 +469,22 @@ class PlyLoad:
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
-        res = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, self.params)
+        params = dataclasses.replace(self.params, friction=0.0) if self.implicit_friction else self.params
+        res, support = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, params,
+                                   pairs=True)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
                   "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes}
+        if self.implicit_friction:
+            extras["friction_support"] = support
         return res.force, st, extras
+
+    def friction(self, support, p, mass, h, extras):
+        """The friction of this step (the integrator's hook, :mod:`jaxform.model`): ``(force (N, 3) N,
+        extras)`` with the friction power in the extras (:func:`jaxform.friction.backward_pair_friction`)."""
+        f_normal, master_nodes, w = support
+        f, pw = backward_pair_friction(p, mass, h, self.slave, master_nodes, w, f_normal, self.params.friction,
+                                       self.params.slip_velocity)
+        return pair_forces(p, self.slave, master_nodes, w, f), dict(extras, friction_power=jnp.sum(pw))
 
 
 __all__ = ["ContactParams", "ContactResult", "HolderState", "penetration",

@@ -9,8 +9,13 @@ that reverse mode through thousands of steps stores only the frames (memory ~ fr
 Central differences (velocities at half steps), the free dofs carrying the momentum ``p``::
 
     f_n     = f_int(x_n) + m g + f_loads(x_n, v_{n-1/2}, t_n) - c m v_{n-1/2}
-    p_{n+½} = p_{n-½} + dt f_n,   v_{n+½} = C p_{n+½}   (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
+    p*      = p_{n-½} + dt f_n
+    p_{n+½} = p* + dt F(p*),      v_{n+½} = C p_{n+½}   (driven dofs: (x_drive(t_{n+1}) - x_n) / dt)
     u_{n+1} = u_n + dt v_{n+½},   x_{n+1} = X + u_{n+1}
+
+``F`` is the friction of the loads that integrate it backward (:mod:`jaxform.model`, the tools and
+the plies: :mod:`jaxform.friction`), applied load after load on the trial momentum ``p*``; it is
+booked with the loads' work.
 
 ``C`` is the inverse mass: ``M^-1`` (lumped), or with a fibre mass (:mod:`jaxform.fibre_mass`)
 the polynomial ``C(x_n)``; with its momentum term on, the dependence on the positions adds

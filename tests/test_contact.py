@@ -346,3 +346,40 @@ def test_backward_friction_solves_the_regularised_law_at_the_end_of_step_slip():
     dp[:, 0] = d
     fd = (np.asarray(fx(p + dp)) - np.asarray(fx(p - dp))) / (2 * d)
     np.testing.assert_allclose(g[1:], fd[1:], rtol=1e-5)
+
+
+def test_backward_pair_friction_conserves_momentum_stops_a_stuck_pair_and_slides_at_coulomb():
+    """Ply on ply, integrated backward (:func:`friction.backward_pair_friction`): the pair forces sum
+    to zero; a sliding pair feels ``mu F_n`` against its relative slip; a node resting on a node
+    (weights (1, 0, 0), equal masses) stops its slip within the step, and one at a triangle's
+    centre keeps a third of it (the Jacobi mass counts each master node fully): no reversal."""
+    m, h, mu, fn, eps = 2e-5, 1e-5, 0.36, 1e-2, 1e-6
+    a = h * mu * fn / m  # slip speed one step of Coulomb friction removes from one node: 1.8e-3 m/s
+    x = np.zeros((4, 3))
+    slave, masters = np.array([3]), np.array([[0, 1, 2]])
+    f_normal = np.array([[0.0, 0.0, fn]])
+    mass = np.full(4, m)
+    pair = jax.jit(friction.backward_pair_friction)
+
+    def after(v, w):
+        p = m * np.asarray(v, float)
+        f, pw = pair(p, mass, h, slave, masters, w, f_normal, mu, eps)
+        forces = np.asarray(contact.pair_forces(jnp.asarray(x), slave, masters, w, f))
+        np.testing.assert_allclose(forces.sum(axis=0), 0.0, atol=1e-15)  # momentum conserved
+        v_new = (p + h * forces) / m
+        return np.asarray(f)[0], v_new[3] - np.asarray(w)[0] @ v_new[:3]
+
+    centre = np.full((1, 3), 1.0 / 3.0)
+    # sliding: 10x the speed one step can remove; Coulomb's force against the relative slip
+    v = np.zeros((4, 3))
+    v[:3, 0] = 0.01
+    v[3, 0] = 0.01 + 10 * a
+    f, _ = after(v, centre)
+    np.testing.assert_allclose(f, [-mu * fn, 0.0, 0.0], rtol=1e-6)
+    # a stuck node on a node: the slip stops in the step (down to the regularised creep)
+    v[3, 0] = 0.01 + 0.3 * a
+    _, rel = after(v, np.array([[1.0, 0.0, 0.0]]))
+    assert abs(rel[0]) < 1e-3 * 0.3 * a
+    # at the triangle's centre: a third of the slip is left, with its sign
+    _, rel = after(v, centre)
+    assert rel[0] == pytest.approx(0.3 * a / 3.0, rel=1e-3)

@@ -296,15 +296,14 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     rho = float(np.max(np.asarray(fab0.areal_mass))) * float(case.mass_scaling)
     c = case.contact
     speed = float(case.process.speed)
-    # explicit frictional contacts per node (the tools' friction is implicit: ToolLoad.friction):
-    # one other ply in a pair, two for a middle ply
-    n_if = min(case.n_plies - 1, 2)
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
                   expected_pressure=expected_pressure(case)[0],
-                  damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=n_if)
-    params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **dict(common, interfaces=0))
+                  damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=0)
+    params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
     params_ply = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
-    common["interfaces"] = n_if + 1  # a folded node: tools or plies, and a layer of itself
+    # explicit frictional contacts per node: the self-contact's own (the tools' and the plies'
+    # friction is integrated backward, ToolLoad.friction and PlyLoad.friction: no stick limit)
+    common["interfaces"] = 1
     params_self = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
 
     area = np.asarray(mesh.node_area, np.float64)

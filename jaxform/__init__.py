@@ -7,7 +7,7 @@ Modules along the data flow (imports point one way along it)::
     units, materials          laws and presets (SI)
     mesh, shell               the fabric shell: one kernel for every use
     geometry                  safe maths, point-triangle closest points, the nearest-triangle search
-    tools, contact            rigid tools, penalty contact with regularised Coulomb friction
+    tools, contact, friction  rigid tools, penalty contact, regularised Coulomb friction
     model, integrate          fixed model / changing state, explicit central differences
     metrics                   wrinkle metric: tool distance, principal curvatures, zones
     forming, cases            hemisphere forming runs (case, presets, rig, fields, summary, driver); the user edge
@@ -33,6 +33,7 @@ _MODULES = (
     "shell",
     "tools",
     "contact",
+    "friction",
     "model",
     "integrate",
     "geometry",

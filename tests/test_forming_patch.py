@@ -86,10 +86,10 @@ def test_block_starts_sliding_at_the_friction_angle():
     d_slide, v_slide, _ = _slide(phi + 1.0, mu)
     th = math.radians(phi + 1.0)
     a = 9.81 * (math.sin(th) - mu * math.cos(th))
-    # below the friction angle: only the creep of the regularised law, at a few eps_v with eps_v
-    # raised to mu p dt / rho_A = mu g cos(theta) dt by the stick limit (the long mass-scaled step
-    # here): a drift, small against the sliding block's
-    assert abs(d_stick) < 0.05 * abs(d_slide) and abs(v_stick) < 0.05 * abs(v_slide)
+    # below the friction angle: only the creep of the regularised law (eps_v = 1e-5 m/s; the
+    # friction integrated backward, no stick limit raises it): measured 0.2 % of the sliding
+    # block's travel, 0.07 % of its speed
+    assert abs(d_stick) < 0.01 * abs(d_slide) and abs(v_stick) < 0.01 * abs(v_slide)
     # above it: sliding with Coulomb's acceleration g (sin - mu cos); a is the small difference of
     # two large terms, so compare the friction coefficient it implies
     mu_eff = (9.81 * math.sin(th) - 2 * d_slide / T**2) / (9.81 * math.cos(th))

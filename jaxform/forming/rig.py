@@ -20,8 +20,10 @@ Numerics (documented choices):
   (a fold under the holder), needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
 * gravity :data:`jaxform.units.GRAVITY` along -z, divided by the mass scaling so the physical
   weight is kept;
-* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed, raised
-  under high pressure so that explicit stick stays stable (:mod:`jaxform.contact`);
+* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed; the
+  tools' and plies' friction is integrated backward (:mod:`jaxform.friction`), the self-contact's
+  explicitly with the regularisation raised under high pressure so that its stick stays stable
+  (:mod:`jaxform.contact`);
 * optional fibre-selective mass scaling ``numerics.fibre_mass_scaling`` (:mod:`jaxform.fibre_mass`):
   the step's membrane limit grows by that factor (the contact then often sets the step);
 * Case B holder: mass ``holder.mass_kg``, critically damped on its contact stiffness.

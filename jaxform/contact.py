@@ -23,8 +23,8 @@ Friction (regularised Coulomb)
     slides at ``v = eps_v r / sqrt(1 - r**2)``, ``r = F / (mu F_n)``. Choose ``eps_v`` small
     against the process speed (``jaxform.cases`` uses 1% of the punch speed).
     In stick that slope acts on the node as a viscous damper ``c = mu p A / eps_v``. Integrated
-    explicitly (``implicit_friction=False`` and the self-contact), it is stable only while ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent
-    of the mesh). Under a clamped holder (Case B, ~15 kPa) with a 1% regularisation that ratio
+    explicitly (``implicit_friction=False`` and the self-contact), it is stable only while
+    ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent of the mesh). Under a clamped holder (Case B, ~15 kPa) with a 1% regularisation that ratio
     reached 5-8 and the tangential velocity flipped sign every step (chatter, then a blow-up).
     So ``eps_v`` is raised where needed to ``mu p * stick_limit`` with ``stick_limit = n dt /
     rho_A`` (tools) or ``2 n dt / rho_A`` (ply on ply: two nodes share the slip), ``n`` the number
@@ -50,8 +50,8 @@ import jax
 import jax.numpy as jnp
 
 from jaxform import broadphase, tools, validate
-from jaxform.friction import backward_friction, backward_pair_friction, regularised_friction
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
+from jaxform.friction import backward_friction, backward_pair_friction, regularised_friction
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
     quads_to_triangles,

@@ -342,6 +342,12 @@ def holder_step(state: HolderState, reaction_z, *, mass, force, dt, damping=0.0)
 # ---------------------------------------------------------------------------------------------
 
 
+def _in_force(load) -> ContactParams:
+    """The parameters a load's ``force`` evaluates: without friction where the integrator adds it
+    backward (``load.implicit_friction``)."""
+    return dataclasses.replace(load.params, friction=0.0) if load.implicit_friction else load.params
+
+
 @pytree_dataclass
 class ToolLoad:
     """One rigid tool's contact as an external load of :class:`jaxform.model.Model`.
@@ -397,8 +403,7 @@ class ToolLoad:
             vel = jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
         else:
             dz, vel = tool_pose(self.tool, t)
-        params = dataclasses.replace(self.params, friction=0.0) if self.implicit_friction else self.params
-        res = tool_contact(self.tool, x, v, self.offset, self.area, params, dz=dz, tool_velocity=vel,
+        res = tool_contact(self.tool, x, v, self.offset, self.area, _in_force(self), dz=dz, tool_velocity=vel,
                            active=self.active)
         new = load_state
         if self.force_controlled:
@@ -469,9 +474,8 @@ class PlyLoad:
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
-        params = dataclasses.replace(self.params, friction=0.0) if self.implicit_friction else self.params
-        res, support = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area, params,
-                                   pairs=True)
+        res, support = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area,
+                                   _in_force(self), pairs=True)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
                   "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes}
         if self.implicit_friction:

@@ -23,7 +23,7 @@ Friction (regularised Coulomb)
     slides at ``v = eps_v r / sqrt(1 - r**2)``, ``r = F / (mu F_n)``. Choose ``eps_v`` small
     against the process speed (``jaxform.cases`` uses 1% of the punch speed).
     In stick that slope acts on the node as a viscous damper ``c = mu p A / eps_v``. Integrated
-    explicitly (``implicit_friction=False`` and the self-contact), it is stable only while
+    explicitly (``implicit_friction=False``), it is stable only while
     ``c dt / m < 2``, i.e. ``mu p dt / (eps_v rho_A) < 2`` (independent of the mesh). Under a clamped holder (Case B, ~15 kPa) with a 1% regularisation that ratio
     reached 5-8 and the tangential velocity flipped sign every step (chatter, then a blow-up).
     So ``eps_v`` is raised where needed to ``mu p * stick_limit`` with ``stick_limit = n dt /
@@ -32,9 +32,10 @@ Friction (regularised Coulomb)
     holds the summed ratio at 1: more creep under high pressure and large steps, never an
     unstable stick (an 8 mm Case B stack blew up with the per-interface limit alone).
 
-The tools' and the plies' friction is integrated backward by default (:class:`ToolLoad`,
-:class:`PlyLoad`, :mod:`jaxform.friction`), with the plain ``eps_v`` and no stick limit: the raised
-``eps_v`` gave far less than Coulomb under a clamping pressure.
+The tools', the plies' and the self-contact's friction is integrated backward by default
+(:class:`ToolLoad`, :class:`PlyLoad`, :class:`jaxform.self_contact.SelfContactLoad`,
+:mod:`jaxform.friction`), with the plain ``eps_v`` and no stick limit: the raised ``eps_v`` gave
+far less than Coulomb under a clamping pressure.
 
 The automatic penalty stiffness and its checks: :mod:`jaxform.penalty`.
 

@@ -15,8 +15,8 @@ Backward (:func:`backward_friction`, the rigid tools)
     the momentum the previous left. With a fibre mass the solve uses the node's lumped mass and its
     momentum (the fibre mass's coupling to the neighbours is not in the solve).
     Between the plies of a stack the same solve acts on each slave node and its point on the other
-    ply (:func:`backward_pair_friction`); the self-contact of a folded ply keeps the explicit law
-    with the stick limit.
+    ply (:func:`backward_pair_friction`), and in the self-contact of a folded ply
+    (:class:`jaxform.self_contact.SelfContactLoad`), whose two passes each solve half a pair.
 """
 from __future__ import annotations
 
@@ -80,7 +80,7 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
     return force, mag * u
 
 
-def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps_v):
+def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps_v, share=1.0):
     """:func:`backward_friction` between each slave node and its point on the other ply's triangle.
 
     The pair's slip is the slave's trial velocity minus the point's (``sum_j w_j p_j / m_j``); its
@@ -88,11 +88,16 @@ def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps
     count ``w_j**2``: the pairs are solved together (Jacobi), and a master node carries about one
     slave's worth of pairs (its weights over the slaves sum to about 1 on plies of like meshes),
     so that in a uniform stick the pairs stop the slip in one step rather than reverse it.
+    ``share``: the part of the pair's mass one pass may use where every node is a slave and a
+    master at once (``1/2`` in a symmetric two-sided contact: its two passes, each from a layer's
+    nodes to the other layer's faces, together stop the slip once; with ``1`` each they would
+    reverse it, stick then chattering).
 
     Args:
         p: (N, 3) trial momenta, kg·m/s; mass: (N,) lumped masses, kg; h: () step, s.
         slave: (S,) int; master_nodes: (S, 3) int; w: (S, 3) barycentric weights of the points.
         f_normal: (S, 3) normal force on each slave node, N; mu: (); eps_v: () m/s.
+        share: () in (0, 1], default 1.
 
     Returns:
         ``(force (S, 3) on each slave node N (minus ``w`` times it on its master nodes), power (S,) W)``.
@@ -100,7 +105,7 @@ def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps
     m = jnp.asarray(mass, p.dtype)
     v = p / m[:, None]
     v_rel = v[slave] - jnp.sum(w[:, :, None] * v[master_nodes], axis=1)
-    m_pair = 1.0 / (1.0 / m[slave] + jnp.sum(w / m[master_nodes], axis=1))
+    m_pair = share / (1.0 / m[slave] + jnp.sum(w / m[master_nodes], axis=1))
     return backward_friction(m_pair[:, None] * v_rel, m_pair, h, f_normal, mu, eps_v, jnp.zeros(3, p.dtype))
 
 

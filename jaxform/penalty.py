@@ -58,9 +58,9 @@ def contact_params(areal_mass, dt, thickness, *, friction: float = 0.23, slip_ve
     """:class:`ContactParams` with the penalty stiffness chosen automatically (or ``stiffness``)
     and the stick limit ``interfaces * dt / areal_mass``, doubled for ``two_sided`` (ply-on-ply)
     contact; ``interfaces``: how many explicitly integrated frictional contacts a node can have at
-    once (the stick dampers of all act on it and their ratios add up; 0 for the tools and the
-    plies, whose friction :class:`jaxform.contact.ToolLoad` and :class:`jaxform.contact.PlyLoad`
-    integrate backward, without a limit).
+    once (the stick dampers of all act on it and their ratios add up; 0 where the loads integrate
+    the friction backward, without a limit: :class:`jaxform.contact.ToolLoad`,
+    :class:`jaxform.contact.PlyLoad` and the self-contact, as the forming rig builds them).
 
     Also checks, at the edge, that the penetration under ``expected_pressure`` (Pa; 1e5 Pa is well
     above the holder pressure of the paper's 1000 N case) stays below ``max_penetration`` times

@@ -27,6 +27,10 @@ of the blank, with three differences:
   without friction (sliding friction of a layer on a layer is the node–face contact's), each
   pass with half of the edge's share (a third of each triangle beside it) of the area.
 
+The node-to-face friction is integrated backward, as between the plies of a stack
+(:meth:`SelfContactLoad.friction`: no stick limit), each of a fold's two passes solving half of
+each pair.
+
 Candidates come from the cell grid of :mod:`jaxform.broadphase`, refreshed when a node has moved
 by half the skin. Differentiable where it is smooth, like the tool contact; the side and the
 candidate table are integers of the state (no gradient).
@@ -43,7 +47,8 @@ import numpy as np
 from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.batching import any_member
-from jaxform.contact import ContactResult, node_contact, ply_contact
+from jaxform.contact import ContactResult, _in_force, node_contact, pair_forces, ply_contact
+from jaxform.friction import backward_pair_friction
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
                               safe_normalize, segments_sqdist)
 
@@ -190,6 +195,8 @@ class SelfContactLoad:
         tri_edges: (F, 3) int32 the edges of each triangle.
         skin: () m; k (candidate triangles per node), edge_k (candidate edges per edge),
         refresh_every, cap, active_cap, edge_active_cap (room in :class:`Candidates`): static ints.
+        implicit_friction: static; ``True`` (default): the node-to-face friction is integrated
+            backward (:meth:`friction`); ``False``: the explicit law with ``params.stick_limit``.
     """
 
     slave: Any
@@ -217,6 +224,7 @@ class SelfContactLoad:
     edge_active_cap: int = static_field(default=3072)
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=8)
+    implicit_friction: bool = static_field(default=True)
 
     def plausible(self, nodes, tris):
         """(B, M) bool, cheap: the plies may touch and the reference centroid is not closer than
@@ -296,15 +304,20 @@ class SelfContactLoad:
         def part(nodes, edges):  # the contacts of these nodes and edges (-1: a padding slot)
             wn, we = nodes >= 0, edges >= 0
             nodes, edges = jnp.maximum(nodes, 0), jnp.maximum(edges, 0)
-            res = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0, self.area[nodes] * wn,
-                              self.params)
+            res, (f_n, masters, w) = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0,
+                                                 self.area[nodes] * wn, _in_force(self), pairs=True)
             ee = edge_contact(x, v, self.edges, c.edges[edges], self.gap0, self.edge_area[edges] * we, self.params,
                               slave=edges)
             inf = jnp.asarray(jnp.inf, x.dtype)
-            return res.force + ee.force, {
+            extras = {
                 "contact_energy": res.energy + ee.energy, "friction_power": res.friction_power,
                 "max_pressure": jnp.maximum(jnp.max(res.pressure * wn), jnp.max(ee.pressure * we)),
                 "min_gap": jnp.min(jnp.where(wn, res.gap, inf)), "min_edge_gap": jnp.min(jnp.where(we, ee.gap, inf))}
+            if self.implicit_friction:  # the pairs by slave node, whatever the room (the rooms' shapes differ)
+                at = jnp.where(wn, nodes, x.shape[0])  # padding slots dropped
+                extras["friction_support"] = tuple(jnp.zeros((x.shape[0], 3), a.dtype).at[at].set(a, mode="drop")
+                                                   for a in (f_n, masters, w))
+            return res.force + ee.force, extras
 
         # the smallest of three rooms that holds the active nodes and edges: one slot (none active: a
         # flat or smoothly bent ply), the active lists, or everything when they overflow (each room is
@@ -319,10 +332,28 @@ class SelfContactLoad:
         extras.update(refreshes=st.refreshes, active_overflow=c.overflow.astype(jnp.int32))
         return f, st, extras
 
+    def friction(self, support, p, mass, h, extras):
+        """The node-to-face friction of this step (the integrator's hook, :mod:`jaxform.model`):
+        ``(force (N, 3) N, extras)``, :func:`jaxform.friction.backward_pair_friction` on each node
+        and its point on the other layer. Both layers of a fold are slaves of each other's faces
+        (two passes, each with half the normal force), so each pass solves with half the pair's
+        mass (``share = 1/2``): together they stop a stuck slip in the step, not reverse it.
+        Skipped (``lax.cond``) while no node touches."""
+        f_normal, masters, w = support
+
+        def solve():
+            f, pw = backward_pair_friction(p, mass, h, self.slave, masters, w, f_normal, self.params.friction,
+                                           self.params.slip_velocity, share=0.5)
+            return pair_forces(p, self.slave, masters, w, f), jnp.sum(pw)
+
+        force, power = jax.lax.cond(any_member(jnp.any(f_normal != 0)), solve,
+                                    lambda: (jnp.zeros_like(p), jnp.zeros((), p.dtype)))
+        return force, dict(extras, friction_power=power)
+
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
                       skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 8,
-                      active_fraction: float = 0.125, dtype=jnp.float32):
+                      active_fraction: float = 0.125, implicit_friction: bool = True, dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
 
     Args:
@@ -335,6 +366,7 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         k, edge_k, refresh_every, cap: see :class:`SelfContactLoad`.
         active_fraction: room for the nodes and edges near a candidate at a refresh (evaluated each
             step; when more are near, all are evaluated).
+        implicit_friction: see :class:`SelfContactLoad`.
     """
     x0 = np.asarray(x0, np.float64)
     tris = np.asarray(tris, np.int64)
@@ -361,7 +393,7 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin),
         k=k, edge_k=edge_k, refresh_every=refresh_every, cap=cap,
         active_cap=max(64, int(np.ceil(active_fraction * len(x0)))),
-        edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))))
+        edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))), implicit_friction=implicit_friction)
 
 
 def _far(p, pg, c, cg):

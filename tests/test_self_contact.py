@@ -92,8 +92,9 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(f[upper & flat_part, 2] > 0) and np.all(f[lower & flat_part, 2] < 0)  # apart
     np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-4 * np.abs(f).max())  # float32 sums
     # node to face: both passes (each with half the area) add up to one contact, k (0.1 h) A
+    # (the force evaluates the normal contact: its friction is the integrator's, test below)
     fn = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load.slave, load.triangles, st.candidates[0],
-                                        load.gap0, load.area, load.params).force)
+                                        load.gap0, load.area, contact._in_force(load)).force)
     np.testing.assert_allclose(np.median(fn[upper & flat_part, 2]), 1e10 * 0.1 * H * 1e-6, rtol=1e-3)
     # edge to edge: flat layers 0.9 h apart are 0.9 h apart edge to edge as well (another k (0.1 h)
     # on the edges' area: a stiffer contact, no other change), frictionless, pushing apart
@@ -104,7 +105,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     fe_all = jax.jit(lambda y, w: edge_contact(y, w, load.edges, st.candidates.edges, load.gap0, load.edge_area,
                                                load.params).force)(x, jnp.asarray(v, jnp.float32))
     fn_all = jax.jit(lambda y, w: contact.ply_contact(y, w, load.slave, load.triangles, st.candidates.nodes, load.gap0,
-                                                      load.area, load.params).force)(x, jnp.asarray(v, jnp.float32))
+                                                      load.area, contact._in_force(load)).force)(x, jnp.asarray(v, jnp.float32))
     np.testing.assert_allclose(f, np.asarray(fn_all + fe_all), atol=1e-6 * np.abs(f).max())
     small = _load(x0, t, active_fraction=0.0)  # room for 64: overflows, all evaluated
     st_s = small.initial_state(x)
@@ -114,7 +115,6 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert int(ex_s["active_overflow"]) == 1 and int(ex["active_overflow"]) == 0
     assert np.all(fe[upper & flat_part, 2] > 0) and np.abs(fe[upper & flat_part, 1]).max() < 1e-3 * fe[upper, 2].max()
     assert -0.2 * H < float(ex["min_edge_gap"]) < -0.0999 * H  # 0.1 h on the flat, a little more at the turn
-    assert np.all(f[upper & flat_part, 1] < 0)  # friction against the slip
     assert int(st2.step) == 1
     # two-sided: every triangle turned over, the layers are seen from their backs, same forces
     load_r = _load(x0, t[:, ::-1].copy(), active_fraction=1.0)  # the program of `load`
@@ -122,7 +122,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(np.asarray(st_r.candidates[0])[upper & flat_part, 0] < 0)  # the nearest: the other layer
     f_r = np.asarray(_force(load_r, x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
     fn_r = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load_r.slave, load_r.triangles,
-                                          st_r.candidates[0], load_r.gap0, load_r.area, load_r.params).force)
+                                          st_r.candidates[0], load_r.gap0, load_r.area, contact._in_force(load_r)).force)
     np.testing.assert_allclose(fn_r, fn, atol=1e-5 * np.abs(fn).max())
     # edge pairs: flat layers are equally near many edges of the other, which one is taken depends
     # on the order of the candidates; the push on the layer is the same
@@ -137,6 +137,45 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     g = jax.jit(jax.grad(lambda xx: contact.ply_contact(xx, jnp.zeros_like(xx), load.slave, load.triangles, cand,
                                                         load.gap0, load.area, load.params).energy))(x)
     assert np.all(np.isfinite(np.asarray(g))) and float(jnp.abs(g).max()) > 0
+
+
+def test_a_fold_s_friction_is_integrated_backward_coulomb_when_sliding_and_stopping_a_stuck_slip():
+    """The upper layer of a fold slides across the lower one at 1 cm/s, pressed 0.1 h into it.
+    Over a step too short to stop the slip, the friction on the upper layer is Coulomb's
+    ``mu F_n`` against the slip and the lower layer feels the opposite; over a long step it
+    stops the slip in that step without reversing it (the two passes each solve half a pair:
+    with whole pairs they would reverse it)."""
+    nodes, x0, t = _fold(0.9 * H)
+    load = _load(x0, t, active_fraction=1.0)
+    x = jnp.asarray(nodes, jnp.float32)
+    upper = nodes[:, 2] > 0.5 * H
+    flat = (nodes[:, 0] > 0.002) & (nodes[:, 0] < 0.016)
+    lower = ~upper & flat
+    v = jnp.asarray(np.where(upper[:, None], [0.0, 0.01, 0.0], 0.0), jnp.float32)
+    st = load.initial_state(x)
+    support = _force(load, x, v, 0.0, st)[2]["friction_support"]
+    # the node-to-face contact's normal force (the edges' is frictionless)
+    f_n = _ply_contact(x, v, load.slave, load.triangles, st.candidates.nodes, load.gap0, load.area,
+                       contact._in_force(load)).force
+    mass = jnp.full(len(nodes), 3e-7, jnp.float32)  # 0.3 kg/m² on 1e-6 m²
+    hook = jax.jit(lambda p, h: load.friction(support, p, mass, h, {}))
+    p = mass[:, None] * v
+    mu = float(load.params.friction)
+    normal = float(np.sum(np.asarray(f_n)[upper & flat, 2]))
+    f, ex_f = hook(p, jnp.float32(1e-10))  # sliding: mu F_n / m * h = 5e-5 m/s removed
+    f = np.asarray(f)
+    sliding = upper & flat
+    assert -np.sum(f[sliding, 1]) == pytest.approx(mu * normal, rel=0.02)
+    assert np.sum(f[lower, 1]) == pytest.approx(mu * normal, rel=0.02)
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-5 * np.abs(f).max())  # momentum kept
+    # the power: Coulomb's at the slip over every pair (the fold's turn included)
+    assert float(ex_f["friction_power"]) == pytest.approx(mu * float(jnp.sum(f_n[upper, 2])) * 0.01, rel=0.05)
+    f, _ = hook(p, jnp.float32(1e-5))  # stick: the step could remove 5 m/s of slip
+    v_end = (p + 1e-5 * f) / mass[:, None]
+    slip = float(jnp.mean(v_end[upper & flat, 1])) - float(jnp.mean(v_end[lower, 1]))
+    assert 0.0 <= slip < 0.05 * 0.01
+    half = float(jnp.mean(v_end[upper & flat, 1]))
+    assert half == pytest.approx(0.005, rel=0.1)  # both layers end at the mean velocity
 
 
 def test_every_room_of_the_active_lists_gives_the_forces_of_evaluating_all():

@@ -20,10 +20,8 @@ Numerics (documented choices):
   (a fold under the holder), needs a smaller step; rounded down so that a whole number of steps fills each frame interval;
 * gravity :data:`jaxform.units.GRAVITY` along -z, divided by the mass scaling so the physical
   weight is kept;
-* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed; the
-  tools' and plies' friction is integrated backward (:mod:`jaxform.friction`), the self-contact's
-  explicitly with the regularisation raised under high pressure so that its stick stays stable
-  (:mod:`jaxform.contact`);
+* friction regularisation speed ``contact.slip_velocity_fraction`` times the punch speed; every
+  contact's friction (tools, plies, self-contact) is integrated backward (:mod:`jaxform.friction`);
 * optional fibre-selective mass scaling ``numerics.fibre_mass_scaling`` (:mod:`jaxform.fibre_mass`):
   the step's membrane limit grows by that factor (the contact then often sets the step);
 * Case B holder: mass ``holder.mass_kg``, critically damped on its contact stiffness.
@@ -302,11 +300,8 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
                   expected_pressure=expected_pressure(case)[0],
                   damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=0)
     params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
+    # (no stick limit, interfaces=0: every contact's friction is integrated backward, the loads' friction hooks)
     params_ply = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
-    # explicit frictional contacts per node: the self-contact's own (the tools' and the plies'
-    # friction is integrated backward, ToolLoad.friction and PlyLoad.friction: no stick limit)
-    common["interfaces"] = 1
-    params_self = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_fabric), two_sided=True, **common)
 
     area = np.asarray(mesh.node_area, np.float64)
     ply_id = _ply_ids(mesh)
@@ -338,7 +333,7 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     if c.self_contact:
         n = case.n_plies
         pair_ok = np.abs(np.arange(n + 1)[:, None] - np.arange(n + 1)[None, :]) != 1  # neighbours: PlyLoad
-        loads.append(self_contact_load(mesh.nodes, tris, area, ply_id, h, params_self, pair_ok=pair_ok,
+        loads.append(self_contact_load(mesh.nodes, tris, area, ply_id, h, params_ply, pair_ok=pair_ok,
                                        skin=_skin(case), dtype=jdtype))
     return tuple(loads), holder_state
 

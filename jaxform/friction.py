@@ -69,12 +69,20 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
     a = h * mu * fn / m
     eps = jnp.asarray(eps_v, p.dtype)
 
-    def newton(_, u):
-        r = jnp.sqrt(u * u + eps * eps)
-        g = u + a * u / r - u_star
-        return jnp.clip(u - g / (1.0 + a * eps * eps / (r * r * r)), 0.0, u_star)
+    def residual(u):
+        return u + a * u / jnp.sqrt(u * u + eps * eps) - u_star
 
-    u = jax.lax.fori_loop(0, FRICTION_ITERATIONS, newton, jnp.maximum(u_star - a, 0.0))
+    def solve(g, u0):
+        def newton(_, u):
+            r = jnp.sqrt(u * u + eps * eps)
+            return jnp.clip(u - g(u) / (1.0 + a * eps * eps / (r * r * r)), 0.0, u_star)
+
+        return jax.lax.fori_loop(0, FRICTION_ITERATIONS, newton, u0)
+
+    # derivatives by the implicit function theorem at the root (one scalar equation per node: the
+    # tangent solve divides by dg/du), not through the Newton loop: a lighter reverse program
+    u = jax.lax.custom_root(residual, jnp.maximum(u_star - a, 0.0), solve,
+                            lambda g, y: y / g(jnp.ones_like(y)))
     mag = mu * fn * u / jnp.sqrt(u * u + eps * eps)
     force = -mag[:, None] * safe_normalize(qt, fallback=jnp.zeros(3, p.dtype))
     return force, mag * u

@@ -113,21 +113,26 @@ def test_gravity_damping_and_fixed_nodes_settle_to_rest_with_balanced_energy():
     assert float(e.kinetic[-1]) <= 1e-2 * float(e.gravity_work[-1])
 
 
-@pytest.mark.parametrize("every", [4, 5])  # checkpointed segments of 2 steps (2, none left) and of 3 (1, 2 left)
-def test_checkpointed_and_plain_rollouts_agree_and_differentiate(every):
+def test_checkpointed_and_plain_rollouts_agree_and_differentiate():
+    """20 steps as 5 checkpointed frames of 4 (segments of 2, none left), as 4 of 5 (a segment of
+    3, 2 left) and as 5 plain frames of 4: the same loss, frames and gradient (three programs:
+    both segment paths against one plain rollout)."""
     mesh, shell = _plate()
     model = make_model(shell)
 
-    def loss(scale, ckpt):
+    def loss(scale, n_frames, every, ckpt):
         st = init_state(model, v=scale * _kick(mesh))
-        s, fr = rollout(model, st, 2, every, checkpoint=ckpt)
+        s, fr = rollout(model, st, n_frames, every, checkpoint=ckpt)
         return jnp.sum(s.x[:, 2] ** 2), fr.extras
 
     # jitted: eagerly, every operation outside the scans (the initial state's forces) and each
     # scan's transpose compile on their own
-    vg = jax.jit(jax.value_and_grad(loss, has_aux=True), static_argnums=1)
-    ((l1, ex1), g1), ((l2, ex2), g2) = vg(1.0, True), vg(1.0, False)
-    assert g1 != 0.0
-    np.testing.assert_allclose(l1, l2, rtol=1e-12)
-    jax.tree_util.tree_map(lambda a, b: np.testing.assert_allclose(a, b, rtol=1e-12), ex1, ex2)
-    np.testing.assert_allclose(g1, g2, rtol=1e-10)
+    vg = jax.jit(jax.value_and_grad(loss, has_aux=True), static_argnums=(1, 2, 3))
+    (l0, ex0), g0 = vg(1.0, 5, 4, False)
+    assert g0 != 0.0
+    for n_frames, every in ((5, 4), (4, 5)):
+        (l1, ex1), g1 = vg(1.0, n_frames, every, True)
+        np.testing.assert_allclose(l1, l0, rtol=1e-12)
+        np.testing.assert_allclose(g1, g0, rtol=1e-10)
+        last = (lambda a: a[-1]) if every != 4 else (lambda a: a)  # frames of 5 steps: the last is step 20 too
+        jax.tree_util.tree_map(lambda a, b: np.testing.assert_allclose(last(a), last(b), rtol=1e-12), ex1, ex0)

@@ -49,12 +49,16 @@ def tmp_out(tmp_path):
     return out
 
 
-# The longest files first: the two workers take files in collection order (``--dist loadfile
-# --no-loadscope-reorder``; xdist's default order, most tests first, put the one-test notebook and
-# README files last, and the README block ran alone for 40 s after the other worker had finished).
-# Longest first, the short files fill the tail.
-LONG_FIRST = ("test_notebook_", "test_readme.py", "test_fibre_mass.py", "test_integrate.py", "test_self_contact.py",
-              "test_forming.py", "test_cantilever.py", "test_metrics_distance.py", "test_cli_wrinkles.py")
+# The longest files first (longest-processing-time order: the two workers take files in collection
+# order as they come free, ``--dist loadfile --no-loadscope-reorder``; xdist's default order, most
+# tests first, put the one-test notebook and README files last, and the README block ran alone for
+# 40 s after the other worker had finished). The order is each file's measured time (``--durations``,
+# 2026-12-05, both workers, a fresh cache), longest first; the short files fill the tail.
+LONG_FIRST = ("test_forming.py", "test_fibre_mass.py", "test_integrate.py", "test_self_contact.py",
+              "test_metrics_distance.py", "test_cantilever.py", "test_sweep.py", "test_notebook_06",
+              "test_forming_patch.py", "test_readme.py", "test_energy_balance.py", "test_cli_wrinkles.py",
+              "test_shell_element.py", "test_frame_tests.py", "test_cli_demo.py", "test_metrics_wrinkles.py",
+              "test_contact.py", "test_notebook_")
 
 
 def pytest_collection_modifyitems(items):

@@ -107,6 +107,7 @@ def test_measures_of_a_constructed_part_find_its_wrinkles(tmp_path):
     assert _sector_counts([{"angle_deg": a} for a in (10, 170, 200, 350, 80, 280, 300)]) == {"x": 4, "y": 3}
     assert p1["dome_max_deviation_m"] == 0.0
     assert max(p1["symmetry_deviation"].values()) < 1e-6
+    assert max(p1["symmetry_shear"].values()) < 1e-6  # the woven's shear, odd about both axes
     a = p1["section A-A'"]  # along the diagonal: on the ridge's crest
     assert a["max_m"] == pytest.approx(3e-3, rel=0.02) and a["peaks"] == 1
     assert p1["section B-B'"]["peaks"] == 1  # across the flange of quadrant 1: one ridge
@@ -242,3 +243,20 @@ def test_cli_analyses_a_study_folder_and_refuses_bad_input(tmp_path, capsys):
     (tmp_path / "mine" / "notes.txt").write_text("keep")
     assert main(["study", "paper", "--out", str(tmp_path / "mine"), "--analyse-only"]) == 2
     assert "not empty" in capsys.readouterr().err and (tmp_path / "mine" / "notes.txt").read_text() == "keep"
+
+
+def test_the_shear_angle_s_mirror_sign_follows_the_fibre_layout():
+    """0/90° (woven): a mirror keeps each family and reverses the angle between them, the shear is
+    odd (``sin 2 theta`` about the punch axis); +-45° (NCF): a mirror swaps the families, the shear is
+    even (``cos 2 theta``). Each is symmetric under its own rule and far from it under the other."""
+    from jaxform.forming.summary import shear_mirror_odd, symmetry_error
+
+    woven, ncf = (plan(only=o, element_size_mm=8)[0].case() for o in ("case-a-woven", "case-a-ncf"))
+    assert shear_mirror_odd(woven) and not shear_mirror_odd(ncf)
+    g = np.linspace(-0.1, 0.1, 21)
+    X, Y = np.meshgrid(g, g)
+    x = np.stack([X.ravel(), Y.ravel(), 0 * X.ravel()], 1)
+    th = np.arctan2(x[:, 1], x[:, 0])
+    for field, odd in ((np.sin(2 * th), True), (np.cos(2 * th), False)):
+        assert max(symmetry_error(x, field, odd=odd).values()) < 1e-9
+        assert min(symmetry_error(x, field, odd=not odd).values()) > 1.0

@@ -65,6 +65,18 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
     return out
 
 
+def shear_mirror_odd(case, ply: int = 1) -> bool:
+    """Whether ply ``ply``'s shear angle changes sign under the blank's mirrors (the ``odd`` of
+    :func:`symmetry_error`): where its fibres run along the blank's edges (0/90°) a mirror maps each
+    family onto itself and reverses the angle between them; where they run off them (±45°) a mirror
+    swaps the two families, and the angle keeps its sign."""
+    from jaxform.forming.speed import along_edges
+    from jaxform.materials import preset as fabric_preset
+
+    o = case.orientations[ply - 1]
+    return along_edges([a + o for a in fabric_preset(case.fabric.preset).fibre_angles])
+
+
 def _step_choice(info, history) -> dict:
     """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`),
     and the deepest penetration the run's samples saw, as a fraction of the ply thickness (the
@@ -221,5 +233,5 @@ def quasi_static_check(result, half) -> dict:
     return out
 
 
-__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "summarize", "QUASI_STATIC_LIMITS",
+__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "shear_mirror_odd", "summarize", "QUASI_STATIC_LIMITS",
            "quasi_static_check"]

@@ -160,7 +160,7 @@ def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = 
     as :meth:`RunData.frame` gives it, when already read.
     """
     from jaxform import metrics
-    from jaxform.forming.summary import flange_mask, symmetry_error
+    from jaxform.forming.summary import flange_mask, shear_mirror_odd, symmetry_error
 
     x_all, data_all = run.frame(k) if frame is None else frame
     sel, x, faces, data = _ply(run, x_all, data_all, ply)
@@ -185,7 +185,7 @@ def measure_frame(run: RunData, k: int = -1, *, ply: int = 1, curvature: bool = 
         "dome_max_deviation_m": float(dev[dome].max()) if dome.any() else None,
         "flange_deviation_m": _stats(dev[flange]),
         "symmetry_deviation": symmetry_error(x_ref, dev),
-        "symmetry_shear": symmetry_error(x_ref, gamma, odd=True),
+        "symmetry_shear": symmetry_error(x_ref, gamma, odd=shear_mirror_odd(case, ply)),
         "shear_abs_deg": _stats(np.abs(gamma)),
         "M_f_rms_N": _stats(mf),
         "M_f_rms_top2pc_median_radius_m": float(np.median(r[top])) if top.any() else None,

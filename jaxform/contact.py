@@ -343,9 +343,9 @@ def holder_step(state: HolderState, reaction_z, *, mass, force, dt, damping=0.0)
 # ---------------------------------------------------------------------------------------------
 
 
-def _in_force(load) -> ContactParams:
-    """The parameters a load's ``force`` evaluates: without friction where the integrator adds it
-    backward (``load.implicit_friction``)."""
+def force_params(load) -> ContactParams:
+    """The parameters a contact load's ``force`` evaluates (tools, plies, self-contact): without
+    friction where the integrator adds it backward (``load.implicit_friction``)."""
     return dataclasses.replace(load.params, friction=0.0) if load.implicit_friction else load.params
 
 
@@ -404,7 +404,7 @@ class ToolLoad:
             vel = jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
         else:
             dz, vel = tool_pose(self.tool, t)
-        res = tool_contact(self.tool, x, v, self.offset, self.area, _in_force(self), dz=dz, tool_velocity=vel,
+        res = tool_contact(self.tool, x, v, self.offset, self.area, force_params(self), dz=dz, tool_velocity=vel,
                            active=self.active)
         new = load_state
         if self.force_controlled:
@@ -476,7 +476,7 @@ class PlyLoad:
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
         res, support = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area,
-                                   _in_force(self), pairs=True)
+                                   force_params(self), pairs=True)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
                   "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes}
         if self.implicit_friction:
@@ -492,6 +492,6 @@ class PlyLoad:
         return pair_forces(p, self.slave, master_nodes, w, f), dict(extras, friction_power=jnp.sum(pw))
 
 
-__all__ = ["ContactParams", "ContactResult", "HolderState", "penetration",
+__all__ = ["ContactParams", "ContactResult", "HolderState", "penetration", "force_params", "pair_forces",
            "node_contact", "tool_contact", "tool_pose", "ply_contact", "nearest_faces",
            "quads_to_triangles", "holder_step", "ToolLoad", "PlyLoad"]

@@ -47,7 +47,7 @@ import numpy as np
 from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.batching import any_member
-from jaxform.contact import ContactResult, _in_force, node_contact, pair_forces, ply_contact
+from jaxform.contact import ContactResult, force_params, node_contact, pair_forces, ply_contact
 from jaxform.friction import backward_pair_friction
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
                               safe_normalize, segments_sqdist)
@@ -305,7 +305,7 @@ class SelfContactLoad:
             wn, we = nodes >= 0, edges >= 0
             nodes, edges = jnp.maximum(nodes, 0), jnp.maximum(edges, 0)
             res, (f_n, masters, w) = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0,
-                                                 self.area[nodes] * wn, _in_force(self), pairs=True)
+                                                 self.area[nodes] * wn, force_params(self), pairs=True)
             ee = edge_contact(x, v, self.edges, c.edges[edges], self.gap0, self.edge_area[edges] * we, self.params,
                               slave=edges)
             inf = jnp.asarray(jnp.inf, x.dtype)

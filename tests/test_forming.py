@@ -252,6 +252,21 @@ def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
     assert member.complete and member.step_cuts == cut.step_cuts, (member.reason, member.step_cuts)
 
 
+def _clamped_soft():
+    """Case B's holder on 25 mm elements, 3 mm of stroke at 62.5 mm/s, expecting 1 kPa with a soft
+    automatic contact (safety 0.02): ``(rig, its penalty k0, given(k, dt=None))``, the last running
+    the same case with the penalty ``k`` given as a stiffness (never raised) and the step ``dt``."""
+    keys = {"process.stroke_mm": 3, "process.frames": 3, "contact.expected_pressure_Pa": 1e3,
+            "process.speed_mm_per_s": 62.5}
+    rig = forming.build(_coarse("case-b-woven-nlbm", **keys, **{"contact.safety": 0.02}))
+
+    def given(k, dt=None):
+        case = _coarse("case-b-woven-nlbm", **keys, **{"contact.penalty_stiffness_Pa_per_m": k})
+        return forming.run(forming.build(case, dt=dt), catch=True)
+
+    return rig, float(rig.model.loads[0].params.stiffness), given
+
+
 def test_a_contact_the_pressures_sink_into_stiffens_and_the_run_goes_on_with_half_the_step():
     """The driver's adaptive contact (``numerics.STIFFEN_PENETRATION``, ``CONTACT_STIFFEN``): Case B's
     holder (25 mm, 3 mm of stroke at 62.5 mm/s) clamps the flange with 1000 N, far more than the
@@ -263,15 +278,7 @@ def test_a_contact_the_pressures_sink_into_stiffens_and_the_run_goes_on_with_hal
     force, draw-in within 2 %). The full step and the batch member: the slow test below."""
     from jaxform.forming import driver, numerics
 
-    keys = {"process.stroke_mm": 3, "process.frames": 3, "contact.expected_pressure_Pa": 1e3,
-            "process.speed_mm_per_s": 62.5}
-    rig = forming.build(_coarse("case-b-woven-nlbm", **keys, **{"contact.safety": 0.02}))
-    k0 = float(rig.model.loads[0].params.stiffness)
-
-    def given(k, dt=None):
-        case = _coarse("case-b-woven-nlbm", **keys, **{"contact.penalty_stiffness_Pa_per_m": k})
-        return forming.run(forming.build(case, dt=dt), catch=True)
-
+    rig, k0, given = _clamped_soft()
     soft, stiff, auto = given(k0), given(4.0 * k0, rig.info.dt / 2), forming.run(rig)
     assert not soft.complete and "half the ply" in soft.reason and soft.step_cuts == [], soft.reason
     assert auto.complete and stiff.complete and stiff.step_cuts == [], (auto.reason, stiff.reason)
@@ -291,22 +298,14 @@ def test_a_contact_the_pressures_sink_into_stiffens_and_the_run_goes_on_with_hal
 
 @pytest.mark.slow
 def test_the_stiffened_contact_s_draw_in_does_not_follow_the_step_and_a_batch_member_stiffens_alone():
-    """The rest of the test above (slow: two more forming programs, 25 s of the default run): the
+    """The rest of the test above (slow: two more forming programs, about 30 s of the default run): the
     same stiff contact at the full step draws in as much as at half of it (within 2 %; measured
     0.4 %, and 0.2 % from half to a quarter step: the friction, integrated backward, has no creep
     that follows the step; the explicit law's stick limit gave 12 % here); as a batch member the
     automatic run goes on alone the same way."""
     from jaxform.forming import batch
 
-    keys = {"process.stroke_mm": 3, "process.frames": 3, "contact.expected_pressure_Pa": 1e3,
-            "process.speed_mm_per_s": 62.5}
-    rig = forming.build(_coarse("case-b-woven-nlbm", **keys, **{"contact.safety": 0.02}))
-    k0 = float(rig.model.loads[0].params.stiffness)
-
-    def given(k, dt=None):
-        case = _coarse("case-b-woven-nlbm", **keys, **{"contact.penalty_stiffness_Pa_per_m": k})
-        return forming.run(forming.build(case, dt=dt), catch=True)
-
+    rig, k0, given = _clamped_soft()
     stiff, full, auto = given(4.0 * k0, rig.info.dt / 2), given(4.0 * k0, rig.info.dt), forming.run(rig)
     d_stiff, d_full = (r.summary["draw_in"]["edge_mid_m"] for r in (stiff, full))
     assert full.complete and abs(d_full / d_stiff - 1.0) < 0.02, (d_full, d_stiff)

@@ -94,7 +94,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     # node to face: both passes (each with half the area) add up to one contact, k (0.1 h) A
     # (the force evaluates the normal contact: its friction is the integrator's, test below)
     fn = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load.slave, load.triangles, st.candidates[0],
-                                        load.gap0, load.area, contact._in_force(load)).force)
+                                        load.gap0, load.area, contact.force_params(load)).force)
     np.testing.assert_allclose(np.median(fn[upper & flat_part, 2]), 1e10 * 0.1 * H * 1e-6, rtol=1e-3)
     # edge to edge: flat layers 0.9 h apart are 0.9 h apart edge to edge as well (another k (0.1 h)
     # on the edges' area: a stiffer contact, no other change), frictionless, pushing apart
@@ -105,7 +105,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     fe_all = jax.jit(lambda y, w: edge_contact(y, w, load.edges, st.candidates.edges, load.gap0, load.edge_area,
                                                load.params).force)(x, jnp.asarray(v, jnp.float32))
     fn_all = jax.jit(lambda y, w: contact.ply_contact(y, w, load.slave, load.triangles, st.candidates.nodes, load.gap0,
-                                                      load.area, contact._in_force(load)).force)(x, jnp.asarray(v, jnp.float32))
+                                                      load.area, contact.force_params(load)).force)(x, jnp.asarray(v, jnp.float32))
     np.testing.assert_allclose(f, np.asarray(fn_all + fe_all), atol=1e-6 * np.abs(f).max())
     small = _load(x0, t, active_fraction=0.0)  # room for 64: overflows, all evaluated
     st_s = small.initial_state(x)
@@ -122,7 +122,7 @@ def test_fold_closer_than_h_is_pushed_apart_two_sided_without_net_force():
     assert np.all(np.asarray(st_r.candidates[0])[upper & flat_part, 0] < 0)  # the nearest: the other layer
     f_r = np.asarray(_force(load_r, x, jnp.asarray(v, jnp.float32), 0.0, st_r)[0])
     fn_r = np.asarray(_ply_contact(x, jnp.asarray(v, jnp.float32), load_r.slave, load_r.triangles,
-                                          st_r.candidates[0], load_r.gap0, load_r.area, contact._in_force(load_r)).force)
+                                          st_r.candidates[0], load_r.gap0, load_r.area, contact.force_params(load_r)).force)
     np.testing.assert_allclose(fn_r, fn, atol=1e-5 * np.abs(fn).max())
     # edge pairs: flat layers are equally near many edges of the other, which one is taken depends
     # on the order of the candidates; the push on the layer is the same
@@ -156,7 +156,7 @@ def test_a_fold_s_friction_is_integrated_backward_coulomb_when_sliding_and_stopp
     support = _force(load, x, v, 0.0, st)[2]["friction_support"]
     # the node-to-face contact's normal force (the edges' is frictionless)
     f_n = _ply_contact(x, v, load.slave, load.triangles, st.candidates.nodes, load.gap0, load.area,
-                       contact._in_force(load)).force
+                       contact.force_params(load)).force
     mass = jnp.full(len(nodes), 3e-7, jnp.float32)  # 0.3 kg/m² on 1e-6 m²
     hook = jax.jit(lambda p, h: load.friction(support, p, mass, h, {}))
     p = mass[:, None] * v

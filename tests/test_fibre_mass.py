@@ -351,13 +351,6 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     # (jaxform.batching), so a batch is not bit-identical to single runs, and the spun blank is chaotic
 
 
-def _image(nodes, sx, sy):
-    """Node ``i``'s image under the map ``(x, y) -> (sx x, sy y)`` of a blank centred at the origin."""
-    key = np.round(np.asarray(nodes)[:, :2] * 1e6).astype(np.int64)
-    lut = {(a, b): i for i, (a, b) in enumerate(map(tuple, key))}
-    return np.array([lut[(sx * a, sy * b)] for a, b in map(tuple, key)])
-
-
 def test_the_blank_s_shell_forces_and_fibre_mass_keep_its_mirror_symmetry():
     """The woven Case A blank (union-jack triangles) is mirror-symmetric, and so must be what the step
     does with it: the shell forces of a mirrored displacement and the fibre mass's ``C p`` of a
@@ -365,8 +358,10 @@ def test_the_blank_s_shell_forces_and_fibre_mass_keep_its_mirror_symmetry():
     check on the single-diagonal grid fails (the mesh, not the physics, breaks the symmetry there);
     the 180° rotation, which that grid keeps, holds on both. A formed part's asymmetry then comes from
     rounding grown by its buckling, not from the discretisation (woven Case A at 4 mm, last frame's
-    deviation: 1.7 % with the fibre mass, 0.09 % without; benchmarks/results/devices-off-4mm-20261205)."""
+    deviation: 1.7 % with the fibre mass in float32, 0.01 % in float64, 0.09 % without the fibre mass;
+    benchmarks/results/devices-off-4mm-20261205, symmetry-dtype-4mm-20261205)."""
     from jaxform.forming import rig
+    from jaxform.forming.summary import mirror_index
 
     case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.025)
     union = rig.build_mesh(case)
@@ -378,7 +373,8 @@ def test_the_blank_s_shell_forces_and_fibre_mass_keep_its_mirror_symmetry():
         shell = Shell.build(mesh, rig.ply_fabrics(case))
         fm = F.fibre_mass(shell, 12.0, dtype=jnp.float64)
         x0 = np.asarray(mesh.nodes)
-        idx, R = _image(x0, sx, sy), np.diag([sx, sy, 1.0])
+        idx, R = mirror_index(x0, sx, sy), np.diag([sx, sy, 1.0])
+        np.testing.assert_allclose(x0[idx, :2], x0[:, :2] * [sx, sy], atol=1e-9)  # every node has its image
         image = lambda v: (v @ R.T)[idx]  # noqa: E731
         u, p = 2e-3 * rng.normal(size=x0.shape), rng.normal(size=x0.shape)
         f = lambda u: np.asarray(forces_and_energy_soa(jnp.asarray(u).T, shell, displacement=True)[0]).T  # noqa: E731

@@ -53,16 +53,22 @@ def symmetry_error(x_ref, values, *, odd: bool = False) -> dict:
     by reference position and ``s = -1`` for fields that change sign under a mirror (``odd``: the
     shear angle of a 0/90° fabric), else 1.
     """
-    x_ref = np.asarray(x_ref)
     v = np.asarray(values)
     sign = -1.0 if odd else 1.0
-    key = np.round(x_ref[:, :2] * 1e6).astype(np.int64)
-    lut = {(a, b): i for i, (a, b) in enumerate(map(tuple, key))}
     out = {}
     for name, sx, sy in (("x", 1, -1), ("y", -1, 1)):
-        idx = np.array([lut.get((sx * a, sy * b), i) for i, (a, b) in enumerate(map(tuple, key))])
+        idx = mirror_index(x_ref, sx, sy)
         out[name] = float(np.max(np.abs(v - sign * v[idx])) / max(np.max(np.abs(v)), 1e-30))
     return out
+
+
+def mirror_index(x_ref, sx: int, sy: int) -> np.ndarray:
+    """(N,) the node at each node's image under ``(x, y) -> (sx x, sy y)`` (``sx, sy`` = ±1: the
+    mirrors about the blank's axes and the 180° rotation), matched by reference position to 1 µm;
+    a node without an image maps to itself."""
+    key = np.round(np.asarray(x_ref)[:, :2] * 1e6).astype(np.int64)
+    lut = {(a, b): i for i, (a, b) in enumerate(map(tuple, key))}
+    return np.array([lut.get((sx * a, sy * b), i) for i, (a, b) in enumerate(map(tuple, key))])
 
 
 def shear_mirror_odd(case, ply: int = 1) -> bool:
@@ -233,5 +239,5 @@ def quasi_static_check(result, half) -> dict:
     return out
 
 
-__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "shear_mirror_odd", "summarize", "QUASI_STATIC_LIMITS",
+__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize", "QUASI_STATIC_LIMITS",
            "quasi_static_check"]

@@ -239,5 +239,5 @@ def quasi_static_check(result, half) -> dict:
     return out
 
 
-__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize", "QUASI_STATIC_LIMITS",
-           "quasi_static_check"]
+__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
+           "QUASI_STATIC_LIMITS", "quasi_static_check"]

@@ -4,7 +4,8 @@ without the fibre mass (true inertia, the step 0.75 x the shell's own), with the
 stiffness given (so the fibre mass is the only device that differs). Compared with the quasi-static
 check's three figures (forming.quasi_static_check: shear map p95, edge mid-side draw-in, flange
 wrinkle count), each run's energy balance (largest residual over the samples, against the
-largest energy scale) and the last frame's mirror symmetry (summary.symmetry_error). Run: .venv/bin/python run.py OUT_DIR  (both cores, ~50 min)."""
+largest energy scale) and the last frame's mirror symmetry (summary.symmetry_error). Exit 1 if either
+run is incomplete (the check then says why in its reason). Run: .venv/bin/python run.py OUT_DIR  (both cores, ~50 min)."""
 import json
 import sys
 import time
@@ -57,3 +58,4 @@ for name, c in (("shipped", case), ("fibre_mass_off", off)):
 rec["check"] = forming.quasi_static_check(res["shipped"], res["fibre_mass_off"])
 print("check", json.dumps({kk: v for kk, v in rec["check"].items() if "per_frame" not in kk}), flush=True)
 (out / "devices-off.json").write_text(json.dumps(rec, indent=1))
+sys.exit(0 if all(r.complete for r in res.values()) else "run.py: a run is incomplete: see devices-off.json")

@@ -17,9 +17,11 @@ run``. With ``--profile``, cantilever side profiles of the same fabric (``x_mm,z
 at high curvature.
 
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm``, ``shear_scale``, their
-``sigma_*`` (Gauss-Newton / Laplace, checked against the loss two sds either side of the fit and
-widened where it rises less: ``sigma_check``; ``null`` where no finite sd exists), ``determined``
-(sd under 10 %), ``loss_initial``,
+``sigma_*`` (Gauss-Newton / Laplace, checked against the loss along the covariance's principal
+axes, the flattest further out, and widened where it rises less: ``sigma_check``; ``null`` where no
+finite sd exists), ``determined`` (sd under 10 %, not a lower bound; ``b_inf``, ``m0``, ``kappa0`` only
+where the part bends to 5 kappa0), ``moment_band`` (M and its sd up to ``kappa_reach``, what
+wrinkles do determine), ``loss_initial``,
 ``loss_final``, ``rms_mm_per_section`` and ``nrmse_per_section`` (the paper's metric),
 ``gradient_check`` (AD vs central differences at the start and what the fit did about it),
 ``iterations``, ``forming_runs``, ``wall_time_s``, ``misfit`` (the chi-square against what the noise
@@ -181,9 +183,12 @@ def _run(args, section_args, profile_args) -> int:
                sections=[{"file": str(pth), "line_mm": ln} for pth, ln in section_args],
                profiles=[{"file": str(pth), "overhang_mm": L} for pth, L in profile_args])
     cf.write_json(args.out, out, force=args.force)
-    v, s = fit.values, fit.sigma
-    print(f"B_init {v['b_init']:.4g} ± {s['b_init']:.2g} N·m, B_inf {v['b_inf']:.4g} ± {s['b_inf']:.2g} N·m, "
-          f"kappa0 {v['kappa0']:.4g} ± {s['kappa0']:.2g} 1/m; loss {fit.loss_initial:.4g} -> {fit.loss_final:.4g}; "
+    v, s, band = fit.values, fit.sigma, fit.moment_band
+    nd = {k: "" if fit.determined[k] else " (not determined)" for k in fit.determined}
+    print(f"B_init {v['b_init']:.4g} ± {s['b_init']:.2g} N·m{nd['b_init']}, B_inf {v['b_inf']:.4g} ± {s['b_inf']:.2g} "
+          f"N·m{nd['b_inf']}, kappa0 {v['kappa0']:.4g} ± {s['kappa0']:.2g} 1/m{nd['kappa0']}; M at the curvature the "
+          f"wrinkles reach ({band['kappa_per_m'][-1]:.3g} 1/m) {band['moment_N'][-1]:.4g} ± {band['sd_N'][-1]:.2g} N"
+          f"{'' if band['determined'] else ' (not determined)'}; loss {fit.loss_initial:.4g} -> {fit.loss_final:.4g}; "
           "section RMS " + ", ".join(f"{1e3 * r:.3f} mm" for r in fit.rms_per_section)
           + f"; {fit.forming_runs} forming runs, {fit.wall_time:.0f} s; jacobian {fit.jacobian}")
     if fit.gradient_check.get("done") and not fit.gradient_check["agree"]:

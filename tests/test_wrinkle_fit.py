@@ -344,44 +344,108 @@ def test_misfit_is_the_noise_s_own_chi_square_at_the_true_law():
 
 
 def test_checked_covariance_keeps_a_quadratic_loss_and_widens_a_jacobian_steeper_than_the_loss():
-    """jaxform.calibrate.uncertainty: on a linear least-squares problem the probes measure exactly
-    the quadratic model's rise (nothing widened); a Jacobian 10x steeper than the loss (what a rough
-    finite difference gives) had sds 10x too small: the check widens them back to the loss's own
-    Laplace figure; a law below the fit within the probes is reported."""
+    """jaxform.calibrate.uncertainty: on a linear least-squares problem the probes along the
+    covariance's principal axes measure exactly the quadratic model's rise (nothing widened; each
+    axis probed once further out, 4 p runs); a Jacobian 10x steeper than the loss (what
+    a rough finite difference gives) had sds 10x too small: the check widens them back to the loss's
+    own Laplace figure; a probe beyond a bound moves back along its axis; a failed run is a steep
+    loss; a law below the fit is reported."""
     from jaxform.calibrate.uncertainty import checked_covariance
 
     rng = np.random.default_rng(0)
     A = rng.normal(size=(40, 3)) * np.array([1.0, 5.0, 0.2])
     b = rng.normal(size=40)
     q = np.linalg.lstsq(A, b, rcond=None)[0]
+    calls = []
 
     def rows(x):
+        calls.append(x)
         return A @ x - b
 
     r, lo, hi = rows(q), np.full(3, -50.0), np.full(3, 50.0)
     cov = np.linalg.inv(A.T @ A)
+    calls.clear()
     out, rep = checked_covariance(rows, q, r, A, cov, lo, hi, names=("a", "b", "c"))
-    np.testing.assert_allclose(rep["ratio"], 1.0, rtol=1e-9)
-    np.testing.assert_allclose(out, cov, rtol=1e-12)
-    assert rep["lower"] is None
+    np.testing.assert_allclose([a["widened_by"] for a in rep["axes"]], 1.0, rtol=1e-9)
+    np.testing.assert_allclose(out, cov, rtol=1e-9, atol=1e-15)
+    assert rep["lower"] is None and len(calls) == 4 * 3 and not any(a["open"] for a in rep["axes"])
+    for a in rep["axes"]:
+        for pr in a["probes"]:
+            assert pr["measured_rise"] == pytest.approx(pr["predicted_rise"], rel=1e-9)
     steep = 10.0 * A
     out, rep = checked_covariance(rows, q, r, steep, np.linalg.inv(steep.T @ steep), lo, hi, names=("a", "b", "c"))
-    np.testing.assert_allclose(rep["widened_by"], 10.0, rtol=1e-9)
-    np.testing.assert_allclose(np.diag(out), np.diag(cov), rtol=1e-9)
-    # a probe beyond a bound moves onto it; a failed model run at a probe counts as a steep loss
-    hi2 = q + np.array([1e-3, 50.0, 50.0])
-    failing = {"n": 0}
-
-    def rows_fail(x):
-        failing["n"] += 1
-        return np.full(40, np.nan) if x[2] > q[2] else rows(x)
-
+    np.testing.assert_allclose([a["widened_by"] for a in rep["axes"]], 10.0, rtol=1e-9)
+    np.testing.assert_allclose(out, cov, rtol=1e-9, atol=1e-15)
+    # a probe beyond a bound moves back along its axis onto it; a failed model run counts as a steep loss
+    lam, V = np.linalg.eigh(cov)
+    hi2 = q + 1e-3 * np.abs(V[:, 0]).max()
     seen = []
-    out, rep = checked_covariance(rows_fail, q, r, A, cov, lo, hi2, names=("a", "b", "c"), prefetch=seen.extend)
-    assert rep["steps"][0][1] == pytest.approx(1e-3) and rep["measured_rise"][2][1] is None
-    assert len(seen) == failing["n"] == 6 and rep["ratio"][2] == pytest.approx(1.0)
-    # a lower loss within the probes: the fit is not at a minimum
+    out, rep = checked_covariance(lambda x: np.full(40, np.nan) if np.any(x > hi2 - 1e-12) else rows(x), q, r, A, cov,
+                                  lo, hi2, names=("a", "b", "c"), prefetch=seen.extend)
+    steps = [pr["step"] for a in rep["axes"] for pr in a["probes"]]
+    assert len(seen) == len(steps) and all(np.all(x <= hi2 + 1e-12) for x in seen)
+    assert any(pr["measured_rise"] is None for a in rep["axes"] for pr in a["probes"])  # the failed ones
+    np.testing.assert_allclose([a["widened_by"] for a in rep["axes"]], 1.0, rtol=1e-9)
+    # a lower loss at the probes: the fit is not at a minimum
     out, rep = checked_covariance(lambda x: np.array([x[0] ** 2 - 1.0]), np.zeros(1), np.array([-1.0]),
                                   np.ones((1, 1)), np.array([[0.25]]), [-5.0], [5.0], names=("a",))
-    assert rep["lower"]["parameter"] == "a" and rep["lower"]["chi_square"] == pytest.approx(0.0)
-    assert rep["widened_by"][0] == pytest.approx(1e6)  # the loss fell: no finite curvature
+    assert rep["lower"]["chi_square"] == pytest.approx(0.0) and rep["lower"]["significant"]
+
+
+@pytest.mark.parametrize("offset, is_open", [(0.25, False), (4.0, True)])
+def test_checked_covariance_finds_the_flat_valley_under_a_rough_loss(offset, is_open):
+    """jaxform.calibrate.uncertainty: a loss with a flat valley (sd 10 along it) that a rough
+    Jacobian made look steep (Laplace sd 0.1 there), and a roughness that lifts the chi-square by
+    ``offset`` at any law but the fit's (the fit sits in a dip of the rough loss, as an optimum of
+    one does). The first probes see the offset, not the valley, and the valley is not the flattest
+    axis of the Laplace covariance (sd 1 along another); each axis is probed 4x further out while its
+    secant sd keeps growing: with a small offset it ends within 10 % of the valley's sd,
+    with a large one the probes run out and the axis is reported open (its sd a lower bound) and the
+    parameters it dominates with it. The steep axes keep their sds."""
+    from jaxform.calibrate.uncertainty import checked_covariance, open_share
+
+    V = np.linalg.qr(np.random.default_rng(1).normal(size=(3, 3)))[0]
+    u = V[:, 2]
+    # the loss's own curvature V diag(4, 1, 0.01) V^T: sds 0.5, 1, 10
+    q = np.array([0.3, -0.2, 0.1])
+
+    L = np.diag([2.0, 1.0, 0.1]) @ V.T  # L^T L = H
+
+    def rows(x):
+        return np.append(L @ (x - q), math.sqrt(offset) * float(np.any(x != q)))
+
+    J = np.vstack([np.diag([2.0, 1.0, 10.0]) @ V.T, np.zeros(3)])  # steep (g = 100) along the valley
+    cov = np.linalg.inv(J.T @ J)
+    out, rep = checked_covariance(rows, q, np.zeros(4), J, cov, np.full(3, -1e3), np.full(3, 1e3), names="abc")
+    along = math.sqrt(u @ out @ u)
+    ax = max(rep["axes"], key=lambda a: abs(np.dot(a["direction"], u)))
+    assert ax["laplace_sd"] == pytest.approx(0.1) and ax["open"] == is_open
+    if is_open:
+        assert 1.0 < along < 10.0 and max(open_share(rep)) > 0.5
+    else:
+        assert along == pytest.approx(10.0, rel=0.1) and max(open_share(rep)) == 0.0
+    steep = [a for a in rep["axes"] if a is not ax]
+    assert all(not a["open"] and a["widened_by"] == pytest.approx(1.0) for a in steep) and rep["lower"] is None
+
+def test_checked_covariance_profiles_its_probes_to_follow_a_valley_the_jacobian_misses():
+    """jaxform.calibrate.uncertainty: a linear loss with a valley of sd 10, and a Jacobian whose axes
+    are turned 10 degrees from the loss's (Laplace sd 1 along its flattest axis). A probe along
+    that axis climbs the valley's wall (0.87 of the valley's rise per unit step comes from the wall:
+    the axis alone widens it to about 1.1); each probe re-fits the other axes by one Gauss-Newton
+    step of the model before its rise is read (the profile), and the check finds the valley's sd
+    within 10 % along it."""
+    from jaxform.calibrate.uncertainty import checked_covariance
+
+    U = np.linalg.qr(np.random.default_rng(2).normal(size=(3, 3)))[0]
+    L = np.diag([20.0, 5.0, 0.1]) @ U.T  # the loss's sds 0.05, 0.2 and 10 (the valley U[:, 2])
+    c, s = math.cos(math.radians(10.0)), math.sin(math.radians(10.0))
+    J = np.diag([20.0, 5.0, 1.0]) @ (U @ np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])).T
+    q = np.array([0.1, 0.2, -0.3])
+    cov = np.linalg.inv(J.T @ J)
+    u = U[:, 2]
+    out, rep = checked_covariance(lambda x: L @ (x - q), q, np.zeros(3), J, cov, np.full(3, -1e3), np.full(3, 1e3),
+                                  names="abc")
+    assert math.sqrt(u @ cov @ u) < 1.0 and math.sqrt(u @ out @ u) == pytest.approx(10.0, rel=0.1)
+    flat = max(rep["axes"], key=lambda a: a["laplace_sd"])
+    assert any("profiled_rise" in pr and pr["profiled_rise"] < 0.1 * pr["on_axis_rise"] for pr in flat["probes"])
+    assert not any(a["open"] for a in rep["axes"]) and rep["lower"] is None

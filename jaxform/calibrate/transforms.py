@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import math
 
+import jax
 import jax.numpy as jnp
 import numpy as np
 
@@ -53,6 +54,16 @@ def _physical(q, law_kind: str):
     return jnp.stack([law.b_inf, law.m0, law.kappa0, law.b_inf + law.m0 / law.kappa0])
 
 
+def moment_band(q, cov, kappas) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The Voce moment ``M(kappa)`` (N·m/m, ``(n,)``) of ``q`` at ``kappas`` (1/m, ``(n,)``), its
+    standard deviation under the covariance ``cov`` of ``q`` (its first three rows and columns)
+    by the delta method, and the Jacobian ``dM/dq`` ``(n, 3)`` it used."""
+    q = jnp.asarray(np.asarray(q, float)[:3])
+    k = jnp.asarray(np.asarray(kappas, float), q.dtype)
+    m = lambda v: law_from_q(v, "voce").moment(k)  # noqa: E731
+    G = np.asarray(jax.jacfwd(m)(q), float)
+    var = np.einsum("ij,jk,ik->i", G, np.asarray(cov, float)[:3, :3], G)
+    return np.asarray(m(q), float), np.sqrt(np.clip(var, 0.0, None)), G
 
 
 def voce_start(law) -> VoceBending:
@@ -82,4 +93,4 @@ def scaled_shear(shear, s):
     return shear
 
 
-__all__ = ["LAW_KINDS", "law_from_q", "q_from_law", "voce_start", "scaled_shear"]
+__all__ = ["LAW_KINDS", "law_from_q", "q_from_law", "moment_band", "voce_start", "scaled_shear"]

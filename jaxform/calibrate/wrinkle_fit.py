@@ -46,10 +46,13 @@ out-of-plane field of amplitude ``imperfection``, tapered to 0 near the tools), 
 Uncertainty (Laplace / Gauss-Newton): ``cov(q) = c (J^T J)^-1`` with ``J`` the Jacobian used,
 ``c`` the reduced chi-square (at least 1) times the ratio of section rows to independent section
 residuals (smoothing correlates neighbouring rows), mapped to ``(b_inf, m0, kappa0, b_init)`` by the
-delta method, then checked against the loss at two sds either side along each parameter and
-widened where the loss rises less than that model says (:mod:`jaxform.calibrate.uncertainty`,
-2 p more runs). A parameter is *determined* where its standard deviation is under
-:data:`DETERMINED_SD` of its value. A fit is *converged* only where, besides its optimiser having
+delta method, then checked against the loss along the covariance's principal axes (two sds either
+side, then further out while the loss stays flatter than modelled, each probe profiled over the
+other axes: :mod:`jaxform.calibrate.uncertainty`, 4 p to about 16 p runs) and widened where it rises
+less than the model says. A parameter is *determined* where its sd is under :data:`DETERMINED_SD` of
+its value and no ``open`` axis dominates it, and the Voce split (``b_inf``, ``m0``, ``kappa0``) only where
+the part bends to ``DETERMINED_RATIO`` kappa0 (the cantilever fit's rule): wrinkles fix ``M(kappa)`` up
+to ``kappa_reach`` (``moment_band``), not the asymptote. A fit is *converged* only where, besides its optimiser having
 stopped, its chi-square is one the given noise would leave at the true law with probability at
 least :data:`~jaxform.calibrate.uncertainty.MISFIT_P` (``misfit``; the smoothed rows' exact mean
 and variance), and with profiles each block of data apart too (the sections, the profiles:
@@ -74,11 +77,11 @@ from scipy.stats.qmc import LatinHypercube
 from jaxform import cantilever
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
-from jaxform.calibrate.cantilever_fit import GN_TOL, ProfileModel, fit_cantilever
+from jaxform.calibrate.cantilever_fit import DETERMINED_RATIO, GN_TOL, ProfileModel, fit_cantilever
 from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, sections_of
-from jaxform.calibrate.transforms import _physical, law_from_q, q_from_law, scaled_shear, voce_start
-from jaxform.calibrate.uncertainty import block_misfit, checked_covariance
+from jaxform.calibrate.transforms import _physical, law_from_q, moment_band, q_from_law, scaled_shear, voce_start
+from jaxform.calibrate.uncertainty import block_misfit, checked_covariance, describe_axis, open_share
 from jaxform.metrics import section_nrmse
 
 PARAM_KINDS = ("voce", "voce+shear")
@@ -88,6 +91,7 @@ GRAD_RTOL = 0.3  # AD agrees with central differences where |g_ad - g_fd| <= GRA
 SPAN = 10.0  # B_init and kappa0 are searched within this factor of the starting law
 SHEAR_SPAN = 3.0
 DETERMINED_SD = 0.10
+BAND = (0.25, 0.5, 0.75, 1.0)  # the moment band's curvatures, fractions of kappa_reach
 MOVE_RTOL = 0.01  # the fit moves to a probe of its final Jacobian that lowers the loss by more than this fraction
 NAMES = ("B_init", "B_inf/B_init", "kappa0", "shear scale")
 START_HALF_WIDTH = (math.log(2.0), math.log(3.0), math.log(3.0), math.log(1.5))  # global phase box, log space
@@ -133,6 +137,7 @@ class WrinkleFit:
     misfit: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.misfit at the fitted law
     local_fits: list = dataclasses.field(default_factory=list)  # steps (4)-(5) from each start tried (fit_wrinkles, step 6)
     cantilever_start: dict | None = None  # the law of the profiles alone (joint fit), a start of step (3)
+    moment_band: dict = dataclasses.field(default_factory=dict)  # M(kappa) and its sd up to kappa_reach
 
     def as_dict(self) -> dict:
         v, s = self.values, {k: (x if math.isfinite(x) else None) for k, x in self.sigma.items()}
@@ -149,7 +154,7 @@ class WrinkleFit:
                "forming_runs": self.forming_runs, "wall_time_s": self.wall_time, "converged": self.converged,
                "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts],
                "sigma_check": self.sigma_check, "misfit": self.misfit, "local_fits": self.local_fits,
-               "cantilever_start": self.cantilever_start}
+               "cantilever_start": self.cantilever_start, "moment_band": self.moment_band}
         if self.profile_rmse is not None:
             out["profile_rmse_mm"] = 1e3 * self.profile_rmse
         return out
@@ -453,7 +458,19 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     shear = float(math.exp(q[3])) if p == 4 else 1.0
     if p == 4:
         sigma["shear_scale"] = float(shear * math.sqrt(max(cov[3, 3], 0.0)))
-    determined = {k: bool(sigma[k] < DETERMINED_SD * abs(values[k])) for k in sigma}
+    # determined: a small sd that no open axis of the sigma check dominates, and for the Voce split
+    # (b_inf, m0, kappa0) a part bent to DETERMINED_RATIO kappa0 (the asymptote each depends on)
+    Tp = np.zeros((len(sigma), p))
+    Tp[:4, :3] = T
+    if p == 4:
+        Tp[4, 3] = shear
+    split = reach >= DETERMINED_RATIO * values["kappa0"]
+    determined = {k: bool(sigma[k] < DETERMINED_SD * abs(values[k]) and o < 0.5 and (split or k in ("b_init", "shear_scale")))
+                  for k, o in zip(sigma, open_share(sigma_check, Tp))}
+    m, sm, G = moment_band(q, cov, reach * np.array(BAND))
+    band = {"kappa_per_m": (reach * np.array(BAND)).tolist(), "moment_N": m.tolist(), "sd_N": sm.tolist(),
+            "determined": bool(np.all(sm < DETERMINED_SD * np.abs(m)) and np.all(
+                open_share(sigma_check, np.pad(G, ((0, 0), (0, p - 3)))) < 0.5))}
     fitted = [y[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
     init = [y0[a:b] for a, b in zip(cuts[:-1], cuts[1:])]
     rms = [float(np.sqrt(np.mean((f - s.amplitude) ** 2))) for f, s in zip(fitted, sections)]
@@ -475,9 +492,11 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     at = [NAMES[i] for i in range(p) if q[i] <= lo[i] + 1e-6 or (q[i] >= hi[i] - 1e-6 and i != 1)]
     if at:
         reasons.append(f"{', '.join(at)} at the search bound")
-    if sigma_check["lower"] is not None:
-        reasons.append(f"a law {sigma_check['probe_sds']:g} sds from the fit along {sigma_check['lower']['parameter']} "
-                       f"fits better (chi-square {sigma_check['lower']['chi_square']:.4g} against {chi2:.4g})")
+    low = sigma_check["lower"]
+    if low is not None and low["significant"]:
+        reasons.append(f"a law {low['step_sds']:.3g} sds from the fit along the covariance's axis "
+                       f"{describe_axis(low['direction'], NAMES[:p])} fits better (chi-square {low['chi_square']:.4g} against "
+                       f"{chi2:.4g}, more than the loss's roughness {sigma_check['roughness']:.3g} explains)")
     fit_misfit = block_misfit(r, blocks)
     if not fit_misfit["consistent"]:
         worst = [(k, fit_misfit["blocks"][k]) for k in fit_misfit["failed"]] or [("", fit_misfit)]
@@ -496,7 +515,7 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
         moves=opt.moves, forming_runs=runs.runs,
         wall_time=wall, converged=converged and not reasons, reason="; ".join(reasons),
         starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov,
-        sigma_check=sigma_check, misfit=fit_misfit, local_fits=local_fits, cantilever_start=cant)
+        sigma_check=sigma_check, misfit=fit_misfit, local_fits=local_fits, cantilever_start=cant, moment_band=band)
 
 
 __all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "predict_sections", "sections_of", "section_loss", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",

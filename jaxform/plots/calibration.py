@@ -98,12 +98,18 @@ def wrinkle_fit_figure(fit, sections, *, truth=None, title: str = ""):
     for name, law, c in laws:
         axes[n].plot(k, np.asarray(law.moment(k)), color=c, lw=1.5, ls="--" if name == "truth" else "-", label=name)
         axes[n + 1].plot(k, np.asarray(law.stiffness(k)) * 1e3, color=c, lw=1.5, ls="--" if name == "truth" else "-")
+    band = getattr(fit, "moment_band", None) or {}
+    if band:  # M and 2 sds where the fit reports them (up to kappa_reach)
+        axes[n].errorbar(band["kappa_per_m"], band["moment_N"], yerr=2.0 * np.asarray(band["sd_N"]), fmt="none",
+                         ecolor="C0", capsize=3, label="fitted M ± 2 sd" + ("" if band["determined"] else " (not determined)"))
     for ax, lab in ((axes[n], "moment per width M, N"), (axes[n + 1], "B = dM/dkappa, N·mm")):
         ax.axvline(fit.kappa_reach, color="grey", ls=":", label="curvature the wrinkles reach")
         ax.set_xlabel("curvature, 1/m")
         ax.set_ylabel(lab)
     axes[n].legend(fontsize=7)
-    axes[n + 1].set_title(f"B_init {fit.values['b_init']:.3g} N·m, B_inf {fit.values['b_inf']:.3g} N·m", fontsize=9)
+    det = {k: "" if getattr(fit, "determined", {}).get(k, True) else " (not det.)" for k in ("b_init", "b_inf")}
+    axes[n + 1].set_title(f"B_init {fit.values['b_init']:.3g} N·m{det['b_init']}, B_inf {fit.values['b_inf']:.3g} "
+                          f"N·m{det['b_inf']}", fontsize=9)
     return _finish(fig, axes, title)
 
 

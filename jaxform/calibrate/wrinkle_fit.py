@@ -81,7 +81,7 @@ from jaxform.calibrate.cantilever_fit import DETERMINED_RATIO, GN_TOL, ProfileMo
 from jaxform.calibrate.imperfections import imperfections
 from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, sections_of
 from jaxform.calibrate.transforms import _physical, law_from_q, moment_band, q_from_law, scaled_shear, voce_start
-from jaxform.calibrate.uncertainty import block_misfit, checked_covariance, describe_axis, open_share
+from jaxform.calibrate.uncertainty import EXTEND_ROUNDS, block_misfit, checked_covariance, describe_axis, open_share
 from jaxform.metrics import section_nrmse
 
 PARAM_KINDS = ("voce", "voce+shear")
@@ -199,7 +199,7 @@ def _bounds(q0, kind):
 def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Sequence | None = None,
                  areal_mass: float | None = None, noise: float = NOISE, profile_noise: float | None = None,
                  smoothing: float | None = None, ply: int = 1, n_starts: int = 8, max_iter: int = 8, restarts: int = 2,
-                 fd_step: float = FD_STEP, gradient_check: bool = True, seeds: int = 1,
+                 fd_step: float = FD_STEP, gradient_check: bool = True, seeds: int = 1, check_rounds: int = EXTEND_ROUNDS,
                  imperfection: float | None = None, batch_width: int | None = None, workers: int | None = None,
                  profile_kwargs: dict | None = None, callback: Callable[[Progress], Any] | None = None) -> WrinkleFit:
     """Fit the bending law of ``case`` to measured wrinkle sections (module docstring).
@@ -219,6 +219,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         max_iter: residual evaluations of the optimiser (``max_nfev``).
         restarts: local fits from the next-best starts where a fit fails the misfit test (step 6).
         fd_step: log-space step of the finite differences.
+        check_rounds: the sigma check's further probes per axis at most (``checked_covariance``'s ``rounds``).
         gradient_check: compare AD with central differences at the start (else: FD Jacobian).
         seeds: imperfect blanks averaged per evaluation (1: the perfect blank only).
         imperfection: their amplitude, m (default a tenth of the ply thickness).
@@ -241,7 +242,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
                         ("seeds", seeds, int(seeds) >= 1), ("n_starts", n_starts, int(n_starts) >= 1),
                         ("max_iter", max_iter, int(max_iter) >= 1), ("restarts", restarts, int(restarts) >= 0),
                         ("workers", workers, workers is None or int(workers) >= 1),
-                        ("smoothing", smoothing, smoothing is None or smoothing >= 0)):
+                        ("smoothing", smoothing, smoothing is None or smoothing >= 0),
+                        ("check_rounds", check_rounds, int(check_rounds) >= 0)):
         if not ok:
             raise ValueError(f"fit_wrinkles: {name} = {v!r} is out of range")
     if profiles and not (areal_mass and areal_mass > 0):
@@ -415,7 +417,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     q, r, J, opt, _ = chosen
     local_fits = [dict(f, q_final=list(map(float, f["q_final"]))) for f in fits]
     return _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi,
-                      starts, q0, time.perf_counter() - t0, rows, blocks, local_fits, cant)
+                      starts, q0, time.perf_counter() - t0, rows, blocks, local_fits, cant, int(check_rounds))
 
 
 def _cantilever_start(prof, areal_mass, profile_kwargs, noise, p, lo, hi) -> dict:
@@ -437,7 +439,7 @@ def _n_prof(prof) -> int:
 
 
 def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi, starts, q0,
-               wall, rows, blocks, local_fits, cant) -> WrinkleFit:
+               wall, rows, blocks, local_fits, cant, check_rounds) -> WrinkleFit:
     p = len(q)
     y, valid, ok, reach = runs.evaluate([q])[0]
     y0 = runs.evaluate([q0])[0][0]
@@ -447,7 +449,7 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     chi2 = float(r @ r)
     c = max(1.0, chi2 / max(n_eff - p, 1)) * (n_sec + _n_prof(prof)) / n_eff
     cov, sigma_check = checked_covariance(rows, q, r, J, c * np.linalg.pinv(J.T @ J), lo, hi, names=NAMES[:p],
-                                          prefetch=runs.evaluate)
+                                          prefetch=runs.evaluate, rounds=check_rounds)
     dtype = jnp.result_type(float)
     phys = np.asarray(_physical(jnp.asarray(q[:3], dtype), "voce"), float)
     T = np.asarray(jax.jacfwd(lambda v: _physical(v, "voce"))(jnp.asarray(q[:3], dtype)), float)

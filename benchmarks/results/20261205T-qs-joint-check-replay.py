@@ -2,7 +2,10 @@
 Jacobian and scale as fit_wrinkles builds them; the forming runs are deterministic, so the rows
 reproduce the fit's chi-square 255.44) with the check of the commit after f09056f: principal axes,
 probed further out while the loss stays flatter than modelled, each probe profiled (one Gauss-Newton
-step of the other axes). Reports the checked sds and where the truth lies in them.
+step of the other axes). Reports the checked sds and where the truth lies in them. Its records were
+made by code before the commit's final rule: the JSON of this name took each axis's last round on
+its flatter side, ``-meanside`` the mean of the two sides; ``-final.py`` reads this JSON's probes with
+the committed rule (the widest round).
 Run: python 20261205T-qs-joint-check-replay.py OUT.json (nothing else running; about 12 min)."""
 import json, pathlib, runpy, sys, time
 import numpy as np

@@ -67,3 +67,5 @@ if __name__ == "__main__":  # (20261205T-qs-joint-check-replay.py runs the set-u
     print(json.dumps(res, indent=1))
     json.dump({"q_fit": q_fit.tolist(), "q_true": q_true.tolist(), "points": res, "wall_s": time.perf_counter() - t0},
               open(sys.argv[1], "w"), indent=1)
+    if not all(r["ok"] for r in res):
+        sys.exit(f"{sys.argv[1]}: a forming run failed (ok false): the scan is incomplete")

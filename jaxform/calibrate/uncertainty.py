@@ -95,8 +95,7 @@ def checked_covariance(rows: Callable[[np.ndarray], np.ndarray], q, r, J, cov, l
     lam, V = np.linalg.eigh(0.5 * (cov + cov.T))
     sd = np.sqrt(np.clip(lam, 0.0, None))
     g = np.einsum("ij,ij->j", J @ V, J @ V)  # the model's rise per squared step along each axis
-    axes = [{"direction": V[:, j].tolist(), "laplace_sd": float(sd[j]), "probes": [], "open": False}
-            for j in range(p)]
+    axes = [{"direction": V[:, j].tolist(), "laplace_sd": float(sd[j]), "probes": []} for j in range(p)]
     lower = None
 
     def probe(todo, n):  # [(axis, t)] in round n: both sides of each axis, one batch; then the profiled points
@@ -109,11 +108,10 @@ def checked_covariance(rows: Callable[[np.ndarray], np.ndarray], q, r, J, cov, l
             axes[j]["probes"].append(e)
             note(j, e, x, chi)
             if math.isfinite(chi):  # re-fit the other axes by the model (one Gauss-Newton step): the profile
-                Jo = J @ V[:, [i for i in range(p) if i != j]]
-                d = np.linalg.lstsq(Jo, -rx, rcond=None)[0]
-                if chi - float(np.sum((rx + Jo @ d) ** 2)) > k * k * lam[j] * g[j]:
-                    xo = np.clip(x + V[:, [i for i in range(p) if i != j]] @ d, lo, hi)
-                    prof.append((j, e, xo))
+                Vo = np.delete(V, j, axis=1)
+                d = np.linalg.lstsq(J @ Vo, -rx, rcond=None)[0]
+                if chi - float(np.sum((rx + J @ Vo @ d) ** 2)) > k * k * lam[j] * g[j]:
+                    prof.append((j, e, np.clip(x + Vo @ d, lo, hi)))
         for (j, e, xo), (_, chi) in zip(prof, _evaluate(rows, [x for _, _, x in prof], prefetch)):
             e["profiled_q"], e["profiled_rise"] = xo.tolist(), chi - chi0
             e["measured_rise"] = min(e["measured_rise"], chi - chi0)

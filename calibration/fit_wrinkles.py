@@ -5,7 +5,7 @@ through the forming simulation; jointly with cantilever side profiles when given
         [--section B.csv --line ...] [--profile P.csv --overhang-mm L ... --areal-mass-gsm W]
         [--params voce|voce+shear] --out params.json [--plot fit.png] [--force]
         [--element-size-mm S] [--set KEY=VALUE ...] [--noise-mm 0.05] [--smoothing-mm W] [--ply 1]
-        [--starts 8] [--max-iter 8] [--restarts 2] [--seeds 1] [--no-gradient-check]
+        [--starts 8] [--max-iter 8] [--restarts 2] [--seeds 1] [--scatter-seeds N] [--no-gradient-check]
 
 A section CSV has the header ``s_mm,amplitude_mm``: the position along the line from (X0, Y0) in
 the top view of the formed part (mm, punch axis at the origin, as ``jaxform run`` writes it) and
@@ -18,7 +18,8 @@ at high curvature.
 
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm``, ``shear_scale``, their
 ``sigma_*`` (Gauss-Newton / Laplace, checked against the loss along the covariance's principal
-axes, the flattest further out, and widened where it rises less: ``sigma_check``; ``null`` where no
+axes, the flattest further out, and widened where it rises less: ``sigma_check``; plus the scatter of
+the fitted law's part from ``--scatter-seeds`` imperfect blanks: ``scatter``; ``null`` where no
 finite sd exists), ``determined`` (sd under 10 %, not a lower bound; ``b_inf``, ``m0``, ``kappa0`` only
 where the part bends to 5 kappa0), ``moment_band`` (M and its sd up to ``kappa_reach``, what
 wrinkles do determine), ``loss_initial``,
@@ -86,6 +87,7 @@ def _pairs(ap, args):
     for name, v, ok in (("--noise-mm", args.noise_mm, args.noise_mm > 0), ("--starts", args.starts, args.starts >= 1),
                         ("--max-iter", args.max_iter, args.max_iter >= 1), ("--seeds", args.seeds, args.seeds >= 1),
                         ("--restarts", args.restarts, args.restarts >= 0),
+                        ("--scatter-seeds", args.scatter_seeds, args.scatter_seeds is None or args.scatter_seeds >= 0),
                         ("--ply", args.ply, args.ply >= 1),
                         ("--smoothing-mm", args.smoothing_mm, args.smoothing_mm is None or args.smoothing_mm >= 0),
                         ("--areal-mass-gsm", args.areal_mass_gsm, args.areal_mass_gsm is None or args.areal_mass_gsm > 0),
@@ -125,6 +127,9 @@ def main(argv=None) -> int:
     ap.add_argument("--restarts", type=int, default=2,
                     help="local fits from the next-best starts where a fit fails the misfit test (default 2)")
     ap.add_argument("--seeds", type=int, default=1, help="imperfect blanks averaged per evaluation (default 1)")
+    ap.add_argument("--scatter-seeds", type=int, default=None,
+                    help="imperfect blanks run at the fitted law for its uncertainty (default: the fit's, "
+                         "jaxform.calibrate.wrinkle_fit.SCATTER_SEEDS; 0: none)")
     ap.add_argument("--no-gradient-check", action="store_true", help="skip AD vs FD at the start (the fit uses FD)")
     ap.add_argument("--progress-every", type=float, default=30.0, metavar="S", help="seconds between progress lines")
     args = ap.parse_args(argv)
@@ -168,7 +173,8 @@ def _run(args, section_args, profile_args) -> int:
             areal_mass=None if args.areal_mass_gsm is None else units.gsm_to_kg_per_m2(args.areal_mass_gsm),
             noise=args.noise_mm * 1e-3, smoothing=None if args.smoothing_mm is None else args.smoothing_mm * 1e-3,
             ply=args.ply, n_starts=args.starts, max_iter=args.max_iter, restarts=args.restarts, seeds=args.seeds,
-            gradient_check=not args.no_gradient_check, callback=progress)
+            gradient_check=not args.no_gradient_check, callback=progress,
+            **({} if args.scatter_seeds is None else {"scatter_seeds": args.scatter_seeds}))
     except ValueError as err:  # a section the case's rig cannot produce
         progress.close()
         print(f"{PROG}: error: {err}", file=sys.stderr)
@@ -193,6 +199,11 @@ def _run(args, section_args, profile_args) -> int:
           + f"; {fit.forming_runs} forming runs, {fit.wall_time:.0f} s; jacobian {fit.jacobian}")
     if fit.gradient_check.get("done") and not fit.gradient_check["agree"]:
         print(f"gradient check: {fit.gradient_check['action']}")
+    if fit.scatter.get("chi_squares"):
+        chis = fit.scatter["chi_squares"]
+        print(f"the fitted law from {len(chis)} imperfect blanks: chi-square {min(chis):.4g} to {max(chis):.4g} "
+              f"(its own {2.0 * fit.loss_final:.4g}); their scatter's share of the B_init variance "
+              f"{100.0 * fit.scatter['share'][0]:.0f} %")
     print(f"wrote {args.out}")
     if args.plot is not None:
         from jaxform.plots import calibration as pc

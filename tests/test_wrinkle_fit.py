@@ -294,6 +294,7 @@ def _csv(path, s_mm, a_mm):
     (["--line", "100,100,200,200"], r"outside the 250 mm square blank"),
     (["--line", "60,60"], r"four numbers X0,Y0,X1,Y1"),
     (["--line", "60,60,120,120", "--set", "fabric.nope=1"], r"fabric.nope"),
+    (["--line", "60,60,120,120", "--scatter-seeds", "-1"], r"--scatter-seeds"),
 ])
 def test_fit_wrinkles_script_refuses_input(tmp_path, capsys, extra, match):
     sec = _csv(tmp_path / "a.csv", np.linspace(0, 80, 21), np.zeros(21))
@@ -449,3 +450,68 @@ def test_checked_covariance_profiles_its_probes_to_follow_a_valley_the_jacobian_
     flat = max(rep["axes"], key=lambda a: a["laplace_sd"])
     assert any("profiled_rise" in pr and pr["profiled_rise"] < 0.1 * pr["on_axis_rise"] for pr in flat["probes"])
     assert not any(a["open"] for a in rep["axes"]) and rep["lower"] is None
+
+
+def test_scatter_covariance_is_the_spread_of_the_fits_that_the_scatter_alone_moves():
+    """jaxform.calibrate.uncertainty.scatter_covariance against an independent reference: the same
+    linear least-squares problem re-fitted (numpy lstsq) to each sample of a correlated scatter (a
+    shifting wrinkle: a few smooth shapes with random weights, 400 rows). The second moment of those
+    fits' shifts is what it must give; the scatter's part along the Jacobian's columns maps one to
+    one (a deviation J d moves the fit by -d), the part orthogonal to them not at all."""
+    from jaxform.calibrate.uncertainty import scatter_covariance
+
+    rng = np.random.default_rng(5)
+    t = np.linspace(0.0, 1.0, 400)
+    J = np.stack([np.ones_like(t), t, np.sin(3.0 * t)], 1) * 30.0
+    shapes = np.stack([np.exp(-((t - c) / 0.05) ** 2) for c in (0.3, 0.5, 0.7)], 1)
+    d = rng.normal(size=(200, 3)) @ shapes.T  # (samples, rows)
+    cov0 = np.diag([1e-4, 2e-4, 3e-4])
+    total, rep = scatter_covariance(J, d, cov0)
+    shifts = np.array([np.linalg.lstsq(J, -x, rcond=None)[0] for x in d])
+    assert np.allclose(total - cov0, shifts.T @ shifts / len(d), rtol=1e-8, atol=1e-14)
+    assert rep["samples"] == 200 and 0.0 < min(rep["share"]) and max(rep["share"]) < 1.0
+    step = np.array([0.01, -0.02, 0.005])
+    one = scatter_covariance(J, [J @ step], np.zeros((3, 3)))[0]
+    assert np.allclose(one, np.outer(step, step), atol=1e-12)
+    ortho = np.linalg.svd(J, full_matrices=True)[0][:, 3]  # orthogonal to every column of J
+    assert np.allclose(scatter_covariance(J, [ortho], cov0)[0], cov0, atol=1e-15)
+    none, rep0 = scatter_covariance(J, [], cov0)
+    assert np.array_equal(none, cov0) and rep0["samples"] == 0
+    r = rng.normal(size=400)
+    chis = scatter_covariance(J, d[:2], cov0, r)[1]["chi_squares"]
+    assert np.allclose(chis, [np.sum((r + x) ** 2) for x in d[:2]])
+
+
+def test_the_fit_adds_the_scatter_of_its_law_from_imperfect_blanks(monkeypatch):
+    """fit_wrinkles runs the fitted law from ``scatter_seeds`` imperfect blanks and adds the scatter
+    they show to its covariance. The forming program is stubbed: amplitudes linear in the law (the
+    moves test's), plus a shift a_k along the B_init shape of ten times the blank's mean imperfection
+    over its amplitude (0 for the fit's perfect blank): each imperfect blank k then moves the fit's
+    log B_init by -a_k, and only that. No forming run."""
+    case, sec = _stub_case()
+    q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
+    shape = np.stack([np.ones(31), np.linspace(-1.0, 1.0, 31), np.zeros(31)], 1)
+    amp = 0.1 * float(case.ply_thickness)
+    a = {}
+
+    def stub(Q, Z, rig, lines, static):
+        z = np.asarray(Z, float)[:, :, 2]
+        shift = (10.0 * z.mean(1) / amp)[:, None]  # 0 for the perfect blank
+        for s in np.ravel(shift):
+            a[round(float(s), 12)] = float(s)
+        y = 1e-3 * ((np.asarray(Q, float) - q_true) @ shape.T + shift * shape[:, 0])
+        return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
+
+    monkeypatch.setattr(section_runs, "_batch", stub)
+    kw = dict(n_starts=1, max_iter=4, gradient_check=False, check_rounds=0)
+    plain = wf.fit_wrinkles(case, [sec], scatter_seeds=0, **kw)
+    fit = wf.fit_wrinkles(case, [sec], scatter_seeds=3, **kw)
+    shifts = sorted(v for v in a.values() if v != 0.0)
+    assert len(shifts) == 3 and fit.scatter["samples"] == 3 and plain.scatter["samples"] == 0
+    extra = np.asarray(fit.covariance) - np.asarray(plain.covariance)
+    assert extra[0, 0] == pytest.approx(np.mean(np.square(shifts)), rel=1e-3)
+    assert np.allclose(np.delete(np.delete(extra, 0, 0), 0, 1), 0.0, atol=1e-9 * extra[0, 0])
+    assert fit.forming_runs == plain.forming_runs + 3 and fit.as_dict()["scatter"]["share"][0] > 0.5
+    assert len(fit.scatter["chi_squares"]) == 3 and min(fit.scatter["chi_squares"]) > 2.0 * fit.loss_final
+    with pytest.raises(ValueError, match="scatter_seeds"):
+        wf.fit_wrinkles(case, [sec], scatter_seeds=-1, **kw)

@@ -114,6 +114,7 @@ class SectionRuns:
         self.static = (param_kind, case.n_plies, _Steps(info.n_frames, info.every), ns, False)
         clearance = np.min([np.asarray(ld.gap(state.x, state.t, ls), float) for ld, ls in zip(model.loads, state.loads)
                             if isinstance(ld, ToolLoad)] or [np.full(len(info.x0), np.inf)], axis=0)
+        self.x0, self.amplitude, self.blank_size, self.clearance = info.x0, imperfection, case.blank_size, clearance
         self.dz = jnp.asarray(imperfections(info.x0, self.seeds, imperfection, case.blank_size, clearance), self.dtype)
         self.cache: dict = {}
         self.runs = 0
@@ -149,12 +150,25 @@ class SectionRuns:
                              all(r[2] for r in rs), float(np.mean([r[3] for r in rs])))
         return [self.cache[k] for k in keys]
 
-    def _chunk(self, chunk):
-        """One batch ``[(key, seed), ...]``: host ``(y, valid, ok, reach)``, the runs it took and the
-        laws that needed the momentum term (run again with it where they failed without)."""
+    def scatter(self, q, n: int) -> list:
+        """``(y (M,), valid (M,), ok)`` of the law ``q`` from ``n`` imperfect blanks other than the
+        fit's own (seeds ``seeds .. seeds + n - 1`` of :func:`imperfections`, the same amplitude): how
+        much the part scatters where only the blank's imperfections differ (host; not cached)."""
+        dz = jnp.asarray(imperfections(self.x0, self.seeds + n, self.amplitude, self.blank_size, self.clearance)[self.seeds:],
+                         self.dtype)
+        chunks = [[(_key(q), i) for i in range(a, min(a + self.width, n))] for a in range(0, n, self.width)]
+        with ThreadPoolExecutor(max(1, min(self.workers, len(chunks)))) as pool:
+            done = list(pool.map(lambda c: self._chunk(c, dz), chunks))
+        self.runs += sum(d[4] for d in done)
+        return [(y[j].astype(float), v[j], bool(ok[j])) for c, (y, v, ok, *_) in zip(chunks, done) for j in range(len(c))]
+
+    def _chunk(self, chunk, dz=None):
+        """One batch ``[(key, seed), ...]`` (``seed`` indexes ``dz``, default the fit's blanks): host
+        ``(y, valid, ok, reach)``, the runs it took and the laws that needed the momentum term (run
+        again with it where they failed without)."""
         pad = chunk + [chunk[-1]] * (self.width - len(chunk))
         Q = jnp.asarray(np.array([k for k, _ in pad]), self.dtype)
-        Z = self.dz[np.array([i for _, i in pad])]
+        Z = (self.dz if dz is None else dz)[np.array([i for _, i in pad])]
         y, v, ok, reach = (np.asarray(t) for t in _batch(Q, Z, self.rig, self.lines, self.static))
         bad = ~ok
         if not (bad[:len(chunk)].any() and len(self.rigs) > 1):
@@ -172,6 +186,25 @@ class SectionRuns:
              for i in range(self.seeds)]
         self.runs += self.seeds
         return np.mean(g, axis=0)
+
+
+def section_loss(case, sections: Sequence, qs, *, noise: float = sec_mod.NOISE, smoothing: float | None = None, ply: int = 1,
+                 gradient_at: Sequence[int] = ()) -> tuple[np.ndarray, dict]:
+    """The fit's section loss ``0.5 |R (y - meas)|^2`` at each log-space law ``qs`` (k, 3)
+    (:func:`~jaxform.calibrate.transforms.q_from_law`) and its AD gradient (checkpointed reverse mode
+    through the run) at the indices ``gradient_at``: ``(losses (k,), {i: (3,)})``; ``inf`` where a
+    run fails. The loss along a line in parameter space shows how rough the landscape is."""
+    for s in sections:
+        sec_mod.check_section(s, case)
+    qs = [np.asarray(q, float) for q in qs]
+    width, workers = parallel(None, None, len(qs))
+    runs = SectionRuns(case, sections, "voce", 1, 0.0, width, ply, workers)
+    R = sec_mod.weights(sections, noise, smoothing if smoothing is not None else float(case.element_size))
+    meas = np.concatenate([s.amplitude for s in sections])
+    evs = runs.evaluate(qs)
+    losses = np.array([0.5 * float(np.sum((R @ np.where(v, y - meas, 0.0)) ** 2)) if ok else np.inf
+                       for y, v, ok, _ in evs])
+    return losses, {i: runs.gradient_ad(qs[i], R, meas, evs[i][1]) for i in gradient_at}
 
 
 def predict_sections(case, sections: Sequence, law=None, *, shear_scale: float = 1.0, ply: int = 1) -> list:
@@ -203,4 +236,4 @@ def sections_of(case, lines: dict, law=None, *, spacing: float = 1e-3, ply: int 
             for s, (y, v) in zip(raw, predict_sections(case, raw, law, ply=ply))]
 
 
-__all__ = ["GRAD_FRAMES", "KAPPA_PERCENTILE", "SectionRuns", "predict_sections", "sections_of"]
+__all__ = ["GRAD_FRAMES", "KAPPA_PERCENTILE", "SectionRuns", "section_loss", "predict_sections", "sections_of"]

@@ -26,6 +26,7 @@ from scipy.linalg import block_diag
 
 from jaxform.metrics.wrinkles import section_profile
 
+NOISE = 5e-5  # m, a scanner's noise on the amplitude (the wrinkle fit's default)
 MIN_LINE = 5e-3  # m: a shorter section line is a line given in metres where millimetres were asked for
 MIN_POINTS = 5
 MAX_OFF_PART = 0.1  # the largest fraction of a section's points that may lie off the simulated part

@@ -49,7 +49,10 @@ residuals (smoothing correlates neighbouring rows), mapped to ``(b_inf, m0, kapp
 delta method, then checked against the loss along the covariance's principal axes (two sds either
 side, then further out while the loss stays flatter than modelled, each probe profiled over the
 other axes: :mod:`jaxform.calibrate.uncertainty`, 4 p to about 16 p runs) and widened where it rises
-less than the model says. A parameter is *determined* where its sd is under :data:`DETERMINED_SD` of
+less than the model says; then the fitted law is run from ``scatter_seeds`` imperfect blanks and the
+scatter of its part is added (:func:`~jaxform.calibrate.uncertainty.scatter_covariance`: what the
+blank's imperfections, in the model and in the measured part, move the fit by; ``chi_squares`` tell
+where the fit has fitted its own blank's chaotic detail). A parameter is *determined* where its sd is under :data:`DETERMINED_SD` of
 its value and no ``open`` axis dominates it, and the Voce split (``b_inf``, ``m0``, ``kappa0``) only where
 the part bends to ``DETERMINED_RATIO`` kappa0 (the cantilever fit's rule): wrinkles fix ``M(kappa)`` up
 to ``kappa_reach`` (``moment_band``), not the asymptote. A fit is *converged* only where, besides its optimiser having
@@ -79,19 +82,21 @@ from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import DETERMINED_RATIO, GN_TOL, ProfileModel, fit_cantilever
 from jaxform.calibrate.imperfections import imperfections
-from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, sections_of
+from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, section_loss, sections_of
 from jaxform.calibrate.transforms import _physical, law_from_q, moment_band, q_from_law, scaled_shear, voce_start
-from jaxform.calibrate.uncertainty import EXTEND_ROUNDS, block_misfit, checked_covariance, describe_axis, open_share
+from jaxform.calibrate.uncertainty import (EXTEND_ROUNDS, block_misfit, checked_covariance, describe_axis, open_share,
+                                           scatter_covariance)
 from jaxform.metrics import section_nrmse
 
 PARAM_KINDS = ("voce", "voce+shear")
-NOISE = 5e-5  # m, a scanner's noise on the amplitude
+NOISE = sec_mod.NOISE
 FD_STEP = 0.05  # log-space step of the finite differences (the gradient check and the FD Jacobian)
 GRAD_RTOL = 0.3  # AD agrees with central differences where |g_ad - g_fd| <= GRAD_RTOL * |g_fd| (each, and the norm)
 SPAN = 10.0  # B_init and kappa0 are searched within this factor of the starting law
 SHEAR_SPAN = 3.0
 DETERMINED_SD = 0.10
 BAND = (0.25, 0.5, 0.75, 1.0)  # the moment band's curvatures, fractions of kappa_reach
+SCATTER_SEEDS = 4  # imperfect blanks run at the fitted law for the uncertainty (uncertainty.scatter_covariance)
 MOVE_RTOL = 0.01  # the fit moves to a probe of its final Jacobian that lowers the loss by more than this fraction
 NAMES = ("B_init", "B_inf/B_init", "kappa0", "shear scale")
 START_HALF_WIDTH = (math.log(2.0), math.log(3.0), math.log(3.0), math.log(1.5))  # global phase box, log space
@@ -134,6 +139,7 @@ class WrinkleFit:
     initial: list  # the same at the starting law
     covariance: np.ndarray  # of q, checked (sigma_check)
     sigma_check: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.checked_covariance
+    scatter: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.scatter_covariance
     misfit: dict = dataclasses.field(default_factory=dict)  # jaxform.calibrate.uncertainty.misfit at the fitted law
     local_fits: list = dataclasses.field(default_factory=list)  # steps (4)-(5) from each start tried (fit_wrinkles, step 6)
     cantilever_start: dict | None = None  # the law of the profiles alone (joint fit), a start of step (3)
@@ -153,7 +159,7 @@ class WrinkleFit:
                "moves_after_optimiser": self.moves,
                "forming_runs": self.forming_runs, "wall_time_s": self.wall_time, "converged": self.converged,
                "reason": self.reason, "starts": [{"q": list(map(float, q)), "loss": c} for q, c in self.starts],
-               "sigma_check": self.sigma_check, "misfit": self.misfit, "local_fits": self.local_fits,
+               "sigma_check": self.sigma_check, "scatter": self.scatter, "misfit": self.misfit, "local_fits": self.local_fits,
                "cantilever_start": self.cantilever_start, "moment_band": self.moment_band}
         if self.profile_rmse is not None:
             out["profile_rmse_mm"] = 1e3 * self.profile_rmse
@@ -169,25 +175,6 @@ class Progress(NamedTuple):
     q: tuple
 
 
-def section_loss(case, sections: Sequence, qs, *, noise: float = NOISE, smoothing: float | None = None, ply: int = 1,
-                 gradient_at: Sequence[int] = ()) -> tuple[np.ndarray, dict]:
-    """The fit's section loss ``0.5 |R (y - meas)|^2`` at each log-space law ``qs`` (k, 3)
-    (:func:`~jaxform.calibrate.transforms.q_from_law`) and its AD gradient (checkpointed reverse mode
-    through the run) at the indices ``gradient_at``: ``(losses (k,), {i: (3,)})``; ``inf`` where a
-    run fails. The loss along a line in parameter space shows how rough the landscape is."""
-    for s in sections:
-        sec_mod.check_section(s, case)
-    qs = [np.asarray(q, float) for q in qs]
-    width, workers = parallel(None, None, len(qs))
-    runs = SectionRuns(case, sections, "voce", 1, 0.0, width, ply, workers)
-    R = sec_mod.weights(sections, noise, smoothing if smoothing is not None else float(case.element_size))
-    meas = np.concatenate([s.amplitude for s in sections])
-    evs = runs.evaluate(qs)
-    losses = np.array([0.5 * float(np.sum((R @ np.where(v, y - meas, 0.0)) ** 2)) if ok else np.inf
-                       for y, v, ok, _ in evs])
-    return losses, {i: runs.gradient_ad(qs[i], R, meas, evs[i][1]) for i in gradient_at}
-
-
 def _bounds(q0, kind):
     lo = np.array([q0[0] - math.log(SPAN), math.log(1e-3), q0[2] - math.log(SPAN)])
     hi = np.array([q0[0] + math.log(SPAN), 0.0, q0[2] + math.log(SPAN)])
@@ -200,6 +187,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
                  areal_mass: float | None = None, noise: float = NOISE, profile_noise: float | None = None,
                  smoothing: float | None = None, ply: int = 1, n_starts: int = 8, max_iter: int = 8, restarts: int = 2,
                  fd_step: float = FD_STEP, gradient_check: bool = True, seeds: int = 1, check_rounds: int = EXTEND_ROUNDS,
+                 scatter_seeds: int = SCATTER_SEEDS,
                  imperfection: float | None = None, batch_width: int | None = None, workers: int | None = None,
                  profile_kwargs: dict | None = None, callback: Callable[[Progress], Any] | None = None) -> WrinkleFit:
     """Fit the bending law of ``case`` to measured wrinkle sections (module docstring).
@@ -220,6 +208,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         restarts: local fits from the next-best starts where a fit fails the misfit test (step 6).
         fd_step: log-space step of the finite differences.
         check_rounds: the sigma check's further probes per axis at most (``checked_covariance``'s ``rounds``).
+        scatter_seeds: imperfect blanks run at the fitted law for the run's own scatter
+            (:func:`~jaxform.calibrate.uncertainty.scatter_covariance`; 0: none).
         gradient_check: compare AD with central differences at the start (else: FD Jacobian).
         seeds: imperfect blanks averaged per evaluation (1: the perfect blank only).
         imperfection: their amplitude, m (default a tenth of the ply thickness).
@@ -243,7 +233,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
                         ("max_iter", max_iter, int(max_iter) >= 1), ("restarts", restarts, int(restarts) >= 0),
                         ("workers", workers, workers is None or int(workers) >= 1),
                         ("smoothing", smoothing, smoothing is None or smoothing >= 0),
-                        ("check_rounds", check_rounds, int(check_rounds) >= 0)):
+                        ("check_rounds", check_rounds, int(check_rounds) >= 0),
+                        ("scatter_seeds", scatter_seeds, int(scatter_seeds) >= 0)):
         if not ok:
             raise ValueError(f"fit_wrinkles: {name} = {v!r} is out of range")
     if profiles and not (areal_mass and areal_mass > 0):
@@ -291,6 +282,11 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     def loss(q, stage="fit"):
         r = rows(q, stage)
         return 0.5 * float(r @ r)
+
+    def scatter_rows(q):  # the rows of the law q from other imperfect blanks, less its own
+        y, valid = runs.evaluate([q])[0][:2]
+        return [np.pad(R @ np.where(v & valid, ys - y, 0.0), (0, n_rows - R.shape[0]))
+                for ys, v, ok in runs.scatter(q, int(scatter_seeds)) if ok] if scatter_seeds else []
 
     def prof_jac(q):
         return prof.jac(q[:3]) * 1e-3 / pn
@@ -417,7 +413,7 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     q, r, J, opt, _ = chosen
     local_fits = [dict(f, q_final=list(map(float, f["q_final"]))) for f in fits]
     return _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi,
-                      starts, q0, time.perf_counter() - t0, rows, blocks, local_fits, cant, int(check_rounds))
+                      starts, q0, t0, rows, blocks, local_fits, cant, int(check_rounds), scatter_rows)
 
 
 def _cantilever_start(prof, areal_mass, profile_kwargs, noise, p, lo, hi) -> dict:
@@ -439,7 +435,7 @@ def _n_prof(prof) -> int:
 
 
 def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, check, mode, opt, lo, hi, starts, q0,
-               wall, rows, blocks, local_fits, cant, check_rounds) -> WrinkleFit:
+               t0, rows, blocks, local_fits, cant, check_rounds, scatter_rows) -> WrinkleFit:
     p = len(q)
     y, valid, ok, reach = runs.evaluate([q])[0]
     y0 = runs.evaluate([q0])[0][0]
@@ -450,6 +446,7 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     c = max(1.0, chi2 / max(n_eff - p, 1)) * (n_sec + _n_prof(prof)) / n_eff
     cov, sigma_check = checked_covariance(rows, q, r, J, c * np.linalg.pinv(J.T @ J), lo, hi, names=NAMES[:p],
                                           prefetch=runs.evaluate, rounds=check_rounds)
+    cov, scatter = scatter_covariance(J, scatter_rows(q), cov, r)
     dtype = jnp.result_type(float)
     phys = np.asarray(_physical(jnp.asarray(q[:3], dtype), "voce"), float)
     T = np.asarray(jax.jacfwd(lambda v: _physical(v, "voce"))(jnp.asarray(q[:3], dtype)), float)
@@ -515,9 +512,9 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
                                                if prof is not None else None),
         kappa_reach=reach, gradient_check=check, jacobian=mode, iterations=int(opt.get("njev") or opt.get("nit") or 0),
         moves=opt.moves, forming_runs=runs.runs,
-        wall_time=wall, converged=converged and not reasons, reason="; ".join(reasons),
+        wall_time=time.perf_counter() - t0, converged=converged and not reasons, reason="; ".join(reasons),
         starts=[(list(map(float, s)), c) for s, c in starts], fitted=fitted, initial=init, covariance=cov,
-        sigma_check=sigma_check, misfit=fit_misfit, local_fits=local_fits, cantilever_start=cant, moment_band=band)
+        sigma_check=sigma_check, scatter=scatter, misfit=fit_misfit, local_fits=local_fits, cantilever_start=cant, moment_band=band)
 
 
 __all__ = ["WrinkleFit", "Progress", "fit_wrinkles", "predict_sections", "sections_of", "section_loss", "voce_start", "scaled_shear", "imperfections", "PARAM_KINDS",

@@ -1,6 +1,6 @@
 """ms per step of a forming run split into the full step, the shell forces, the tool and ply loads, and the fibre mass (its whole inverse and one product with the fibre-tension stiffness), each jitted alone in a lax.scan of n steps, best of 3. Run: python split.py PRESET SIZE_MM N (nothing else running)."""
 import sys, time, json
-import jax, jax.numpy as jnp, numpy as np
+import jax, jax.numpy as jnp
 from jaxform import forming, cases
 from jaxform import fibre_mass as _fm
 from jaxform.shell import forces_and_energy_sym

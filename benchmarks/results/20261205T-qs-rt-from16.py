@@ -6,7 +6,7 @@ import dataclasses, json, sys, time
 import numpy as np
 import jax.numpy as jnp
 sys.path.insert(0, str(__import__("pathlib").Path(__file__).resolve().parents[1]))
-from bench_wrinkle_fit import TRUTH, FIT_LINES, HELD_OUT, OVERRIDES, make_sections, moment_error
+from bench_wrinkle_fit import TRUTH, FIT_LINES, OVERRIDES, make_sections, moment_error
 from jaxform import cases
 from jaxform.calibrate import wrinkle_fit
 from jaxform.calibrate.transforms import law_from_q

@@ -204,6 +204,9 @@ def _run(args, section_args, profile_args) -> int:
         print(f"the fitted law from {len(chis)} imperfect blanks: chi-square {min(chis):.4g} to {max(chis):.4g} "
               f"(its own {2.0 * fit.loss_final:.4g}); their scatter's share of the B_init variance "
               f"{100.0 * fit.scatter['share'][0]:.0f} %")
+    if fit.scatter.get("failed"):
+        print(f"note: the fitted law's run failed from {fit.scatter['failed']} imperfect blank(s); left out of its "
+              "uncertainty (the law forms this part only from a near-perfect blank)")
     print(f"wrote {args.out}")
     if args.plot is not None:
         from jaxform.plots import calibration as pc

@@ -492,7 +492,7 @@ def test_the_fit_adds_the_scatter_of_its_law_from_imperfect_blanks(monkeypatch):
     q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
     shape = np.stack([np.ones(31), np.linspace(-1.0, 1.0, 31), np.zeros(31)], 1)
     amp = 0.1 * float(case.ply_thickness)
-    a = {}
+    a, fail = {}, [False]
 
     def stub(Q, Z, rig, lines, static):
         z = np.asarray(Z, float)[:, :, 2]
@@ -500,7 +500,8 @@ def test_the_fit_adds_the_scatter_of_its_law_from_imperfect_blanks(monkeypatch):
         for s in np.ravel(shift):
             a[round(float(s), 12)] = float(s)
         y = 1e-3 * ((np.asarray(Q, float) - q_true) @ shape.T + shift * shape[:, 0])
-        return y, np.ones_like(y, bool), np.ones(len(Q), bool), np.full(len(Q), 10.0)
+        ok = ~(fail[0] & (np.ravel(shift) != 0.0))  # fail[0]: every imperfect blank's run fails
+        return y, np.ones_like(y, bool), ok, np.full(len(Q), 10.0)
 
     monkeypatch.setattr(section_runs, "_batch", stub)
     kw = dict(n_starts=1, max_iter=4, gradient_check=False, check_rounds=0)
@@ -508,10 +509,15 @@ def test_the_fit_adds_the_scatter_of_its_law_from_imperfect_blanks(monkeypatch):
     fit = wf.fit_wrinkles(case, [sec], scatter_seeds=3, **kw)
     shifts = sorted(v for v in a.values() if v != 0.0)
     assert len(shifts) == 3 and fit.scatter["samples"] == 3 and plain.scatter["samples"] == 0
+    assert fit.scatter["failed"] == 0 and plain.scatter["failed"] == 0
     extra = np.asarray(fit.covariance) - np.asarray(plain.covariance)
     assert extra[0, 0] == pytest.approx(np.mean(np.square(shifts)), rel=1e-3)
     assert np.allclose(np.delete(np.delete(extra, 0, 0), 0, 1), 0.0, atol=1e-9 * extra[0, 0])
     assert fit.forming_runs == plain.forming_runs + 3 and fit.as_dict()["scatter"]["share"][0] > 0.5
     assert len(fit.scatter["chi_squares"]) == 3 and min(fit.scatter["chi_squares"]) > 2.0 * fit.loss_final
+    fail[0] = True  # failed blanks are left out and counted, not read as no scatter silently
+    failed = wf.fit_wrinkles(case, [sec], scatter_seeds=2, **kw)
+    assert failed.scatter["samples"] == 0 and failed.scatter["failed"] == 2
+    assert np.allclose(failed.covariance, plain.covariance)
     with pytest.raises(ValueError, match="scatter_seeds"):
         wf.fit_wrinkles(case, [sec], scatter_seeds=-1, **kw)

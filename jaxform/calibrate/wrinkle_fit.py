@@ -283,10 +283,10 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
         r = rows(q, stage)
         return 0.5 * float(r @ r)
 
-    def scatter_rows(q):  # the rows of the law q from other imperfect blanks, less its own
+    def scatter_rows(q):  # the rows of the law q from other imperfect blanks, less its own; and how many were run
         y, valid = runs.evaluate([q])[0][:2]
         return [np.pad(R @ np.where(v & valid, ys - y, 0.0), (0, n_rows - R.shape[0]))
-                for ys, v, ok in runs.scatter(q, int(scatter_seeds)) if ok] if scatter_seeds else []
+                for ys, v, ok in runs.scatter(q, int(scatter_seeds)) if ok] if scatter_seeds else [], int(scatter_seeds)
 
     def prof_jac(q):
         return prof.jac(q[:3]) * 1e-3 / pn
@@ -446,7 +446,9 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     c = max(1.0, chi2 / max(n_eff - p, 1)) * (n_sec + _n_prof(prof)) / n_eff
     cov, sigma_check = checked_covariance(rows, q, r, J, c * np.linalg.pinv(J.T @ J), lo, hi, names=NAMES[:p],
                                           prefetch=runs.evaluate, rounds=check_rounds)
-    cov, scatter = scatter_covariance(J, scatter_rows(q), cov, r)
+    dev, asked = scatter_rows(q)
+    cov, scatter = scatter_covariance(J, dev, cov, r)
+    scatter["failed"] = asked - len(dev)  # imperfect blanks whose run failed (left out)
     dtype = jnp.result_type(float)
     phys = np.asarray(_physical(jnp.asarray(q[:3], dtype), "voce"), float)
     T = np.asarray(jax.jacfwd(lambda v: _physical(v, "voce"))(jnp.asarray(q[:3], dtype)), float)

@@ -50,9 +50,10 @@ from typing import Any
 import jax
 import jax.numpy as jnp
 
-from jaxform import broadphase, tools, validate
+from jaxform import backward_normal, broadphase, tools, validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.friction import backward_friction, backward_pair_friction, regularised_friction
+from jaxform.holder import HolderState, holder_step  # noqa: F401  (re-exported)
 from jaxform.geometry import (  # noqa: F401  (quads_to_triangles re-exported)
     closest_point_triangle,
     quads_to_triangles,
@@ -243,7 +244,7 @@ def _ply_node(p, vp, tri_x, tri_v, side, gap0, area, params):
     signed = jnp.where(jnp.dot(d, n) < -0.5 * dist, -dist, dist)
     v_master = w[j] @ tri_v[j]
     force, pressure, g, e, pw = node_contact(signed, n, vp - v_master, gap0, area, params)
-    return force, w[j], j, pressure, g, e, pw
+    return force, w[j], j, pressure, g, e, pw, n
 
 
 def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactParams, *, pairs: bool = False):
@@ -272,7 +273,8 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
 
     Returns:
         :class:`ContactResult` with ``force`` (N, 3) on all nodes, ``pressure``/``gap`` (N_s,); with
-        ``pairs``, also ``(f (N_s, 3) on each slave, master_nodes (N_s, 3) int, weights (N_s, 3))``.
+        ``pairs``, also ``(f (N_s, 3) on each slave, master_nodes (N_s, 3) int, weights (N_s, 3),
+        normals (N_s, 3))`` (the normal points from the master face to the slave).
     """
     x, v = jnp.asarray(x), jnp.asarray(v)
     slave = jnp.asarray(slave)
@@ -282,13 +284,13 @@ def ply_contact(x, v, slave, triangles, candidates, gap0, area, params: ContactP
     area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (ns,))
     side = jnp.where(cand >= 0, 1.0, -1.0).astype(x.dtype)
     tri_c = tri[jnp.where(cand >= 0, cand, ~cand)]  # (N_s, K, 3) node indices
-    f, w, j, p, g, e, pw = jax.vmap(_ply_node, in_axes=(0, 0, 0, 0, 0, None, 0, None))(
+    f, w, j, p, g, e, pw, nrm = jax.vmap(_ply_node, in_axes=(0, 0, 0, 0, 0, None, 0, None))(
         x[slave], v[slave], x[tri_c], v[tri_c], side, jnp.asarray(gap0, x.dtype), area, params
     )
     master_nodes = jnp.take_along_axis(tri_c, j[:, None, None], axis=1)[:, 0, :]  # (N_s, 3)
     res = ContactResult(force=pair_forces(x, slave, master_nodes, w, f), reaction=jnp.zeros(3, x.dtype), pressure=p,
                         gap=g, energy=jnp.sum(e), friction_power=jnp.sum(pw))
-    return (res, (f, master_nodes, w)) if pairs else res
+    return (res, (f, master_nodes, w, nrm)) if pairs else res
 
 
 def pair_forces(x, slave, master_nodes, w, f):
@@ -296,46 +298,6 @@ def pair_forces(x, slave, master_nodes, w, f):
     its master triangle's nodes ``master_nodes`` (N_s, 3) with the barycentric weights ``w``."""
     force = jnp.zeros_like(x).at[slave].add(f)
     return force.at[master_nodes.reshape(-1)].add((-w[:, :, None] * f[:, None, :]).reshape(-1, 3))
-
-
-# ---------------------------------------------------------------------------------------------
-# Force-controlled blank holder
-# ---------------------------------------------------------------------------------------------
-
-
-@pytree_dataclass
-class HolderState:
-    """State of a force-controlled blank holder (1 DOF, vertical).
-
-    Attributes:
-        dz: () vertical displacement from its reference pose, m.
-        vz: () vertical velocity at the last half step, m/s (leapfrog).
-    """
-
-    dz: Any = 0.0
-    vz: Any = 0.0
-
-
-def holder_step(state: HolderState, reaction_z, *, mass, force, dt, damping=0.0) -> HolderState:
-    """Advance the blank holder one central-difference step.
-
-    ``m a = -force + R_z - c v``, ``v_{n+1/2} = v_{n-1/2} + dt a_n``, ``z_{n+1} = z_n + dt
-    v_{n+1/2}`` — the same leapfrog as the fabric.
-
-    Args:
-        state: :class:`HolderState` at step n.
-        reaction_z: () vertical force of the fabric on the holder at step n, N (the ``reaction[2]``
-            of :func:`tool_contact` for the holder).
-        mass: () holder mass, kg (a numerical parameter: any mass with
-            ``sqrt(k_contact / mass) dt < 2`` is stable).
-        force: () prescribed clamping force pushing the holder down, N (1000 N for Case B),
-            including the holder's weight.
-        dt: () time step, s.
-        damping: () viscous damping of the holder, N·s/m.
-    """
-    a = (-force + reaction_z - damping * state.vz) / mass
-    vz = state.vz + dt * a
-    return HolderState(dz=state.dz + dt * vz, vz=vz)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -367,8 +329,12 @@ class ToolLoad:
         clamp_force, mass, damping, dt: holder control (N, kg, N·s/m, s); unused when prescribed.
         force_controlled: static.
         implicit_friction: static; ``True`` (default): ``force`` returns the normal force and the
-            integrator adds the friction through :meth:`friction` (:func:`backward_friction`);
+            integrator adds the friction through :meth:`backward` (:func:`backward_friction`);
             ``False``: the explicit law with ``params.stick_limit``, inside ``force``.
+        implicit_normal: static; ``True``: the normal force too acts at the end of the step
+            (:mod:`jaxform.backward_normal`: any stiffness is stable), and the friction with it
+            backward whatever ``implicit_friction`` says; a force-controlled holder then moves in
+            :meth:`backward`, with the reaction of the step.
     """
 
     tool: Any
@@ -382,6 +348,7 @@ class ToolLoad:
     dt: Any = 0.0
     force_controlled: bool = static_field(default=False)
     implicit_friction: bool = static_field(default=True)
+    implicit_normal: bool = static_field(default=False)
 
     @property
     def law(self) -> ContactParams:
@@ -398,12 +365,24 @@ class ToolLoad:
         g = phi - jnp.broadcast_to(jnp.asarray(self.offset, x.dtype), phi.shape)
         return jnp.where(jnp.broadcast_to(jnp.asarray(self.active), phi.shape) > 0, g, jnp.inf)
 
-    def force(self, x, v, t, load_state):
+    def _pose(self, t, load_state):
         if self.force_controlled:
-            dz = load_state.dz
-            vel = jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
-        else:
-            dz, vel = tool_pose(self.tool, t)
+            return load_state.dz, jnp.stack([0.0 * load_state.vz, 0.0 * load_state.vz, load_state.vz])
+        return tool_pose(self.tool, t)
+
+    def force(self, x, v, t, load_state):
+        dz, vel = self._pose(t, load_state)
+        if self.implicit_normal:  # the force at the end of the step (backward); here the gap, and the penalty's state
+            phi, normal = tools.sdf(self.tool, x, dz)
+            act = jnp.broadcast_to(jnp.asarray(self.active, x.dtype), phi.shape)
+            area = jnp.broadcast_to(jnp.asarray(self.area, x.dtype), phi.shape) * act
+            g = phi - jnp.broadcast_to(jnp.asarray(self.offset, x.dtype), phi.shape)
+            delta, e = penetration(g, self.params.smooth_width)
+            extras = {"reaction": jnp.zeros(3, x.dtype), "dz": jnp.asarray(dz),
+                      "contact_energy": jnp.sum(area * self.params.stiffness * e),
+                      "friction_power": jnp.zeros((), x.dtype), "max_pressure": jnp.max(self.params.stiffness * delta * act),
+                      "backward_support": (g, normal, area, vel)}
+            return jnp.zeros_like(x), load_state, extras
         res = tool_contact(self.tool, x, v, self.offset, self.area, force_params(self), dz=dz, tool_velocity=vel,
                            active=self.active)
         new = load_state
@@ -413,17 +392,32 @@ class ToolLoad:
         extras = {"reaction": res.reaction, "dz": jnp.asarray(dz), "contact_energy": res.energy,
                   "friction_power": res.friction_power, "max_pressure": jnp.max(res.pressure)}
         if self.implicit_friction:
-            extras["friction_support"] = (res.force, vel)
+            extras["backward_support"] = (res.force, vel)
         return res.force, new, extras
 
-    def friction(self, support, p, mass, h, extras):
-        """The friction of this step (the integrator's hook, :mod:`jaxform.model`): ``(force (N, 3) N,
-        extras)`` for the trial momentum ``p`` (N, 3), lumped ``mass`` (N,) and step ``h``, from the
-        ``support`` that :meth:`force` returned (:func:`backward_friction`); the extras' reaction
-        and friction power then include it."""
-        f_normal, vel = support
+    def backward(self, support, p, mass, h, dt, extras, load_state):
+        """The contact's part of this step integrated backward (the integrator's hook, :mod:`jaxform.model`):
+        ``(force (N, 3) N, extras, load_state)`` for the trial momentum ``p`` (N, 3), lumped ``mass``
+        (N,), the step ``h`` the force acts over and the step ``dt``: with ``implicit_normal`` the
+        normal force (:func:`jaxform.backward_normal.row_forces`, one row a node), then the friction
+        (:func:`backward_friction`) on the momentum it leaves; the extras' reaction and friction power
+        include them, and a force-controlled holder with an implicit normal moves here."""
+        f_n = jnp.zeros_like(p)
+        if self.implicit_normal:
+            g, normal, area, vel = support
+            n = p.shape[0]
+            _, f_n = backward_normal.row_forces(p, mass, h, dt, jnp.arange(n)[:, None], jnp.ones((n, 1), p.dtype), normal,
+                                                g, area, self.params.stiffness, self.params.damping,
+                                                jnp.broadcast_to(vel, (n, 3)))
+            p, f_normal = p + h * f_n, f_n
+        else:
+            f_normal, vel = support
         f, pw = backward_friction(p, mass, h, f_normal, self.params.friction, self.params.slip_velocity, vel)
-        return f, dict(extras, reaction=extras["reaction"] - jnp.sum(f, axis=0), friction_power=jnp.sum(pw))
+        reaction = extras["reaction"] - jnp.sum(f + f_n, axis=0)
+        if self.implicit_normal and self.force_controlled:
+            load_state = holder_step(load_state, reaction[2], mass=self.mass, force=self.clamp_force, dt=self.dt,
+                                     damping=self.damping)
+        return f + f_n, dict(extras, reaction=reaction, friction_power=jnp.sum(pw)), load_state
 
 
 @pytree_dataclass
@@ -440,8 +434,11 @@ class PlyLoad:
         params: :class:`ContactParams`; skin: () m (default ``gap0``);
         k, refresh_every, cap (triangles read per grid cell and page): static ints.
         implicit_friction: static; ``True`` (default): the friction is integrated backward
-            (:meth:`friction`, :func:`jaxform.friction.backward_pair_friction`); ``False``: the
+            (:meth:`backward`, :func:`jaxform.friction.backward_pair_friction`); ``False``: the
             explicit law with ``params.stick_limit``.
+        implicit_normal: static; ``True``: the normal force too acts at the end of the step
+            (:mod:`jaxform.backward_normal`, a row per slave node and its point on the master
+            face), the friction with it backward.
     """
 
     slave: Any
@@ -454,6 +451,7 @@ class PlyLoad:
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=8)
     implicit_friction: bool = static_field(default=True)
+    implicit_normal: bool = static_field(default=False)
 
     def _skin(self):
         return self.gap0 if self.skin is None else self.skin
@@ -475,21 +473,33 @@ class PlyLoad:
 
     def force(self, x, v, t, load_state):
         st = broadphase.refreshed(load_state, x, self.search, 0.5 * self._skin(), self.refresh_every)
-        res, support = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area,
-                                   force_params(self), pairs=True)
+        res, (f, masters, w, nrm) = ply_contact(x, v, self.slave, self.triangles, st.candidates, self.gap0, self.area,
+                                                force_params(self), pairs=True)
         extras = {"contact_energy": res.energy, "friction_power": res.friction_power,
                   "max_pressure": jnp.max(res.pressure), "refreshes": st.refreshes}
+        if self.implicit_normal:
+            area = jnp.broadcast_to(jnp.asarray(self.area, x.dtype), res.gap.shape)
+            extras["backward_support"] = backward_normal.pair_rows(self.slave, masters, w, nrm, res.gap, area)
+            return jnp.zeros_like(x), st, extras
         if self.implicit_friction:
-            extras["friction_support"] = support
+            extras["backward_support"] = (f, masters, w)
         return res.force, st, extras
 
-    def friction(self, support, p, mass, h, extras):
-        """The friction of this step (the integrator's hook, :mod:`jaxform.model`): ``(force (N, 3) N,
-        extras)`` with the friction power in the extras (:func:`jaxform.friction.backward_pair_friction`)."""
-        f_normal, master_nodes, w = support
-        f, pw = backward_pair_friction(p, mass, h, self.slave, master_nodes, w, f_normal, self.params.friction,
+    def backward(self, support, p, mass, h, dt, extras, load_state):
+        """This step's contact integrated backward (the integrator's hook, :mod:`jaxform.model`):
+        ``(force (N, 3) N, extras, load_state)``: with ``implicit_normal`` the normal forces
+        (:func:`jaxform.backward_normal.row_forces`), then the friction
+        (:func:`jaxform.friction.backward_pair_friction`) on the momentum they leave."""
+        f_n = jnp.zeros_like(p)
+        if self.implicit_normal:
+            F, f_n = backward_normal.row_forces(p, mass, h, dt, *support, self.params.stiffness, self.params.damping)
+            p = p + h * f_n
+            f_normal, masters, w = F[:, None] * support[2], support[0][:, 1:], -support[1][:, 1:]
+        else:
+            f_normal, masters, w = support
+        f, pw = backward_pair_friction(p, mass, h, self.slave, masters, w, f_normal, self.params.friction,
                                        self.params.slip_velocity)
-        return pair_forces(p, self.slave, master_nodes, w, f), dict(extras, friction_power=jnp.sum(pw))
+        return pair_forces(p, self.slave, masters, w, f) + f_n, dict(extras, friction_power=jnp.sum(pw)), load_state
 
 
 __all__ = ["ContactParams", "ContactResult", "HolderState", "penetration", "force_params", "pair_forces",

@@ -170,7 +170,7 @@ def _step(model: Model, state: State, x_ref):
     for load, ls in zip(model.loads, state.loads):
         f, ls_new, ex = load.force(x, v_old, t, ls)
         ex = dict(ex)
-        supports.append(ex.pop("friction_support", None))
+        supports.append(ex.pop("backward_support", None))
         f_loads = f_loads + f.T
         new_loads.append(ls_new)
         extras.append(ex)
@@ -183,9 +183,9 @@ def _step(model: Model, state: State, x_ref):
     # on the first step the initial velocity is the full-step velocity: advance half a step
     h = jnp.where(first, 0.5 * dt, dt)
     p_new = free * (state.momentum + h * f_free)
-    for i, (load, sup) in enumerate(zip(model.loads, supports)):  # friction integrated backward (model.py)
+    for i, (load, sup) in enumerate(zip(model.loads, supports)):  # contact integrated backward (model.py)
         if sup is not None:
-            f_fr, extras[i] = load.friction(sup, p_new.T, model.mass, h, extras[i])
+            f_fr, extras[i], new_loads[i] = load.backward(sup, p_new.T, model.mass, h, dt, extras[i], new_loads[i])
             f_fr = free * f_fr.T
             p_new = p_new + h * f_fr
             f_loads = f_loads + f_fr

@@ -19,16 +19,18 @@ of small arrays (contact force, tool position...) saved in every frame under
 ``frames.extras[i]``. The integrator adds ``f`` to the internal, gravity and damping forces and
 books its work as external work. A load must be a pure function of its arguments.
 
-Friction integrated backward (optional): a load whose ``extras`` hold a ``"friction_support"``
+Contact integrated backward (optional): a load whose ``extras`` hold a ``"backward_support"``
 entry (taken out of the extras by the integrator) also has a method::
 
-    load.friction(support, p, mass, h, extras) -> (f, extras)
+    load.backward(support, p, mass, h, dt, extras, load_state) -> (f, extras, load_state)
 
 called once every load's force is in, in ``Model.loads`` order, with ``p`` (N, 3) the trial
-momentum at the end of the step (all other forces, and the friction of the loads before it,
-applied), ``mass`` (N,) the lumped masses and ``h`` the step: ``f`` (N, 3) the friction force it
-adds (booked as external work with the load's force) and the load's extras updated with it
-(:class:`jaxform.contact.ToolLoad`: its reaction and friction power).
+momentum at the end of the step (all other forces, and the backward forces of the loads before it,
+applied), ``mass`` (N,) the lumped masses, ``h`` the step the force acts over and ``dt`` the step:
+``f`` (N, 3) the force it adds (its friction, :mod:`jaxform.friction`, and with an implicit normal
+its normal force, :mod:`jaxform.backward_normal`; booked as external work with the load's force),
+the load's extras updated with it (:class:`jaxform.contact.ToolLoad`: its reaction and friction
+power) and its state (a force-controlled holder advanced with the reaction of the step).
 
 Prescribed motion: ``Model.fixed`` (N, 3) bool marks the degrees of freedom that are driven;
 their positions follow ``Model.drive.position(t)`` (any pytree with that method; the default

@@ -47,6 +47,7 @@ import numpy as np
 from jaxform import broadphase
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.batching import any_member
+from jaxform import backward_normal
 from jaxform.contact import ContactResult, force_params, node_contact, pair_forces, ply_contact
 from jaxform.friction import backward_pair_friction
 from jaxform.geometry import (closest_point_triangle, closest_points_segments, point_triangle_sqdist, safe_norm,
@@ -126,11 +127,12 @@ def _edge_pair(pa, va, qb, vb, gap0, area, params):
     j = jnp.argmin(jnp.sum((ca - cb) ** 2, axis=-1))
     s, t, d = s[j], t[j], ca[j] - cb[j]
     v_rel = (1.0 - s) * va[0] + s * va[1] - (1.0 - t) * vb[j, 0] - t * vb[j, 1]
-    f, p, g, e, _ = node_contact(safe_norm(d), safe_normalize(d), v_rel, gap0, area, params)
-    return f, s, t, j, p, g, e
+    n = safe_normalize(d)
+    f, p, g, e, _ = node_contact(safe_norm(d), n, v_rel, gap0, area, params)
+    return f, s, t, j, p, g, e, n
 
 
-def edge_contact(x, v, edges, candidates, gap0, area, params, slave=None) -> ContactResult:
+def edge_contact(x, v, edges, candidates, gap0, area, params, slave=None, rows: bool = False):
     """Edge-to-edge contact: each edge of ``edges`` (E, 2) int (or of its subset ``slave`` (S,)
     int) against the nearest of its ``candidates`` (E or S, K) int edges, pushed apart below the
     distance ``gap0`` (m) along the line of the closest points, with the penalty and normal
@@ -140,7 +142,9 @@ def edge_contact(x, v, edges, candidates, gap0, area, params, slave=None) -> Con
         x, v: (N, 3) node positions (m) and velocities (m/s); area: () or (E or S,) m² per edge.
 
     Returns:
-        :class:`jaxform.contact.ContactResult` with ``force`` (N, 3), ``pressure``/``gap`` (E or S,).
+        :class:`jaxform.contact.ContactResult` with ``force`` (N, 3), ``pressure``/``gap`` (E or S,);
+        with ``rows``, also ``(nodes (E or S, 4) int, weights (E or S, 4), normal (E or S, 3))``: each
+        edge's contact as a row of :func:`jaxform.backward_normal.row_forces`.
     """
     edges = jnp.asarray(edges)
     e = edges if slave is None else edges[slave]
@@ -148,14 +152,15 @@ def edge_contact(x, v, edges, candidates, gap0, area, params, slave=None) -> Con
     area = jnp.broadcast_to(jnp.asarray(area, x.dtype), e.shape[:1])
     nofric = dataclasses.replace(params, friction=0.0)
     eb = edges[cand]  # (E, K, 2)
-    f, s, t, j, p, g, en = jax.vmap(_edge_pair, in_axes=(0, 0, 0, 0, None, 0, None))(
+    f, s, t, j, p, g, en, nrm = jax.vmap(_edge_pair, in_axes=(0, 0, 0, 0, None, 0, None))(
         x[e], v[e], x[eb], v[eb], jnp.asarray(gap0, x.dtype), area, nofric)
     other = jnp.take_along_axis(eb, j[:, None, None], axis=1)[:, 0]  # (E, 2)
     w = jnp.stack([1.0 - s, s, t - 1.0, -t], axis=1)  # a0, a1 get +f; b0, b1 get -f
     idx = jnp.concatenate([e, other], axis=1)
     force = jnp.zeros_like(x).at[idx.reshape(-1)].add((w[:, :, None] * f[:, None, :]).reshape(-1, 3))
-    return ContactResult(force=force, reaction=jnp.zeros(3, x.dtype), pressure=p, gap=g, energy=jnp.sum(en),
-                         friction_power=jnp.zeros((), x.dtype))
+    res = ContactResult(force=force, reaction=jnp.zeros(3, x.dtype), pressure=p, gap=g, energy=jnp.sum(en),
+                        friction_power=jnp.zeros((), x.dtype))
+    return (res, (idx, w, nrm)) if rows else res
 
 
 def mesh_edges(tris, tri_area):
@@ -196,7 +201,9 @@ class SelfContactLoad:
         skin: () m; k (candidate triangles per node), edge_k (candidate edges per edge),
         refresh_every, cap, active_cap, edge_active_cap (room in :class:`Candidates`): static ints.
         implicit_friction: static; ``True`` (default): the node-to-face friction is integrated
-            backward (:meth:`friction`); ``False``: the explicit law with ``params.stick_limit``.
+            backward (:meth:`backward`); ``False``: the explicit law with ``params.stick_limit``.
+        implicit_normal: static; ``True``: the normal forces too act at the end of the step
+            (:meth:`backward`, :mod:`jaxform.backward_normal`), the friction with them backward.
     """
 
     slave: Any
@@ -225,6 +232,7 @@ class SelfContactLoad:
     refresh_every: int = static_field(default=200)
     cap: int = static_field(default=8)
     implicit_friction: bool = static_field(default=True)
+    implicit_normal: bool = static_field(default=False)
 
     def plausible(self, nodes, tris):
         """(B, M) bool, cheap: the plies may touch and the reference centroid is not closer than
@@ -304,19 +312,30 @@ class SelfContactLoad:
         def part(nodes, edges):  # the contacts of these nodes and edges (-1: a padding slot)
             wn, we = nodes >= 0, edges >= 0
             nodes, edges = jnp.maximum(nodes, 0), jnp.maximum(edges, 0)
-            res, (f_n, masters, w) = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0,
-                                                 self.area[nodes] * wn, force_params(self), pairs=True)
-            ee = edge_contact(x, v, self.edges, c.edges[edges], self.gap0, self.edge_area[edges] * we, self.params,
-                              slave=edges)
+            res, (f_n, masters, w, nrm) = ply_contact(x, v, nodes, self.triangles, c.nodes[nodes], self.gap0,
+                                                      self.area[nodes] * wn, force_params(self), pairs=True)
+            ee, (e_nodes, e_w, e_nrm) = edge_contact(x, v, self.edges, c.edges[edges], self.gap0,
+                                                     self.edge_area[edges] * we, self.params, slave=edges, rows=True)
             inf = jnp.asarray(jnp.inf, x.dtype)
             extras = {
                 "contact_energy": res.energy + ee.energy, "friction_power": res.friction_power,
                 "max_pressure": jnp.maximum(jnp.max(res.pressure * wn), jnp.max(ee.pressure * we)),
                 "min_gap": jnp.min(jnp.where(wn, res.gap, inf)), "min_edge_gap": jnp.min(jnp.where(we, ee.gap, inf))}
-            if self.implicit_friction:  # the pairs by slave node, whatever the room (the rooms' shapes differ)
-                at = jnp.where(wn, nodes, x.shape[0])  # padding slots dropped
-                extras["friction_support"] = tuple(jnp.zeros((x.shape[0], 3), a.dtype).at[at].set(a, mode="drop")
-                                                   for a in (f_n, masters, w))
+            # the pairs by slave node and edge, whatever the room (the rooms' shapes differ); padding slots dropped
+            at, at_e = jnp.where(wn, nodes, x.shape[0]), jnp.where(we, edges, self.edges.shape[0])
+
+            def by(ids, n, a):
+                return jnp.zeros((n,) + a.shape[1:], a.dtype).at[ids].set(a, mode="drop")
+
+            n, ne = x.shape[0], self.edges.shape[0]
+            if self.implicit_normal:
+                nodes4, w4, _, gap, area = backward_normal.pair_rows(nodes, masters, w, nrm, res.gap, self.area[nodes] * wn)
+                extras["backward_support"] = (
+                    tuple(by(at, n, a) for a in (nodes4, w4, nrm, gap, area)),
+                    tuple(by(at_e, ne, a) for a in (e_nodes, e_w, e_nrm, ee.gap, self.edge_area[edges] * we)))
+                return jnp.zeros_like(x), extras
+            if self.implicit_friction:
+                extras["backward_support"] = tuple(by(at, n, a) for a in (f_n, masters, w))
             return res.force + ee.force, extras
 
         # the smallest of three rooms that holds the active nodes and edges: one slot (none active: a
@@ -332,28 +351,43 @@ class SelfContactLoad:
         extras.update(refreshes=st.refreshes, active_overflow=c.overflow.astype(jnp.int32))
         return f, st, extras
 
-    def friction(self, support, p, mass, h, extras):
-        """The node-to-face friction of this step (the integrator's hook, :mod:`jaxform.model`):
-        ``(force (N, 3) N, extras)``, :func:`jaxform.friction.backward_pair_friction` on each node
-        and its point on the other layer. Both layers of a fold are slaves of each other's faces
-        (two passes, each with half the normal force), so each pass solves with half the pair's
-        mass (``share = 1/2``): together they stop a stuck slip in the step, not reverse it.
-        Skipped (``lax.cond``) while no node touches."""
-        f_normal, masters, w = support
+    def backward(self, support, p, mass, h, dt, extras, load_state):
+        """This step's contact integrated backward (the integrator's hook, :mod:`jaxform.model`):
+        ``(force (N, 3) N, extras, load_state)``. With ``implicit_normal`` the normal forces of the
+        node-to-face and edge-to-edge rows, solved together (:func:`jaxform.backward_normal.row_forces`:
+        the two passes of a fold and its edges share the nodes' masses); then the node-to-face friction,
+        :func:`jaxform.friction.backward_pair_friction` on each node and its point on the other layer.
+        Both layers of a fold are slaves of each other's faces (two passes, each with half the normal
+        force), so each pass solves with half the pair's mass (``share = 1/2``): together they stop a
+        stuck slip in the step, not reverse it. Skipped (``lax.cond``) while no node touches."""
+        zero = (jnp.zeros_like(p), jnp.zeros((), p.dtype))
 
-        def solve():
+        def friction(p, f_normal, masters, w):
             f, pw = backward_pair_friction(p, mass, h, self.slave, masters, w, f_normal, self.params.friction,
                                            self.params.slip_velocity, share=0.5)
             return pair_forces(p, self.slave, masters, w, f), jnp.sum(pw)
 
-        force, power = jax.lax.cond(any_member(jnp.any(f_normal != 0)), solve,
-                                    lambda: (jnp.zeros_like(p), jnp.zeros((), p.dtype)))
-        return force, dict(extras, friction_power=power)
+        if not self.implicit_normal:
+            f_normal, masters, w = support
+            force, power = jax.lax.cond(any_member(jnp.any(f_normal != 0)), lambda: friction(p, f_normal, masters, w),
+                                        lambda: zero)
+            return force, dict(extras, friction_power=power), load_state
+        (nodes, w4, nrm, gap, area), (e_nodes, e_w, e_nrm, e_gap, e_area) = support
+
+        def solve():
+            rows = [jnp.concatenate(a) for a in ((nodes, e_nodes), (w4, e_w), (nrm, e_nrm), (gap, e_gap), (area, e_area))]
+            F, f_n = backward_normal.row_forces(p, mass, h, dt, *rows, self.params.stiffness, self.params.damping)
+            f_fr, power = friction(p + h * f_n, F[:nodes.shape[0], None] * nrm, nodes[:, 1:], -w4[:, 1:])
+            return f_n + f_fr, power
+
+        force, power = jax.lax.cond(any_member(jnp.any(area > 0) | jnp.any(e_area > 0)), solve, lambda: zero)
+        return force, dict(extras, friction_power=power), load_state
 
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
                       skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 8,
-                      active_fraction: float = 0.125, implicit_friction: bool = True, dtype=jnp.float32):
+                      active_fraction: float = 0.125, implicit_friction: bool = True, implicit_normal: bool = False,
+                      dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
 
     Args:
@@ -366,7 +400,7 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         k, edge_k, refresh_every, cap: see :class:`SelfContactLoad`.
         active_fraction: room for the nodes and edges near a candidate at a refresh (evaluated each
             step; when more are near, all are evaluated).
-        implicit_friction: see :class:`SelfContactLoad`.
+        implicit_friction, implicit_normal: see :class:`SelfContactLoad`.
     """
     x0 = np.asarray(x0, np.float64)
     tris = np.asarray(tris, np.int64)
@@ -393,7 +427,8 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         tri_edges=as_i(tri_edges), skin=as_f(h if skin is None else skin),
         k=k, edge_k=edge_k, refresh_every=refresh_every, cap=cap,
         active_cap=max(64, int(np.ceil(active_fraction * len(x0)))),
-        edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))), implicit_friction=implicit_friction)
+        edge_active_cap=max(64, int(np.ceil(active_fraction * len(edges)))), implicit_friction=implicit_friction,
+        implicit_normal=implicit_normal)
 
 
 def _far(p, pg, c, cg):

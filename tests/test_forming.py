@@ -201,6 +201,39 @@ def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_sta
     assert steps["1e4"] / steps["1e5"] > 2.5
 
 
+def test_with_the_normal_forces_integrated_backward_the_contact_takes_nothing_from_the_step():
+    """contact.implicit_normal: the step is 0.75 x the shell's whatever the expected pressure, the
+    penalty at least as stiff as the pressure needs (10 % of the ply) and as the explicit rule's
+    where the shell set that one's step."""
+    for p in ("1e4", "1e5"):
+        case, stable, n = _numerics("case-a-woven-nlbm", 8.0, "numerics.fibre_mass_scaling=12",
+                                    "contact.implicit_normal=true", f"contact.expected_pressure_Pa={p}")
+        assert (n.governed_by, n.dt_max) == ("shell", pytest.approx(0.75 * stable))
+        k = n.safety * float(_areal_mass(case)) / n.dt_max**2
+        assert k >= 1.02 * float(p) / (0.1 * case.ply_thickness) * (1 - 1e-12)
+    case, stable, n = _numerics("case-a-woven-nlbm", 4.0, "numerics.fibre_mass_scaling=1", "contact.implicit_normal=true")
+    assert n.safety == pytest.approx(0.2475) and n.budget == pytest.approx(0.75)
+    for name in ("case-b-woven-nlbm", "case-a-woven-nlbm"):  # a clamped holder; a stack of two plies
+        keys = ["numerics.fibre_mass_scaling=12", "contact.implicit_normal=true"]
+        keys += [] if name.startswith("case-b") else ['plies.orientations_deg=[0.0, 90.0]']
+        with pytest.raises(ValueError, match="implicit_normal.*clamped holder.*stack of plies"):
+            _numerics(name, 8.0, *keys)
+
+
+def test_a_run_with_the_normal_forces_integrated_backward_forms_the_part_at_the_shell_s_step():
+    """Woven Case A, 25 mm, 15 mm of stroke with contact.implicit_normal: the step is the shell's
+    (longer than the explicit contact's), the run completes, the ply lies on the punch within 10 %
+    of its thickness and the energy balance closes as the integrator checks it every step."""
+    case = _coarse("case-a-woven-nlbm", process__stroke_mm=15, process__frames=3, contact__implicit_normal="true")
+    r = forming.simulate(case, samples_per_frame=4)
+    assert r.complete, r.reason
+    s = r.summary["numerics"]
+    assert s["dt_governed_by"] == "shell" and s["max_penetration_ply"] < 0.1
+    explicit = forming.build(_coarse("case-a-woven-nlbm", process__stroke_mm=15, process__frames=3))[2]
+    assert r.info.dt >= explicit.dt
+    assert float(np.max(r.history["punch_force_N"])) > 0
+
+
 def _areal_mass(case):
     from jaxform.forming import rig
 

@@ -3,6 +3,8 @@ force finds; a fold lying on itself closer than h is pushed apart, two-sided, mo
 edge against edge catches the crossing of two kinks whose nodes are all far from the other
 layer (forces the gradient of the energy, momentum kept); ordinary bending and a flat sheet are
 not contact; the rig wires it by default."""
+import dataclasses
+
 import numpy as np
 import jax
 import jax.numpy as jnp
@@ -153,12 +155,12 @@ def test_a_fold_s_friction_is_integrated_backward_coulomb_when_sliding_and_stopp
     lower = ~upper & flat
     v = jnp.asarray(np.where(upper[:, None], [0.0, 0.01, 0.0], 0.0), jnp.float32)
     st = load.initial_state(x)
-    support = _force(load, x, v, 0.0, st)[2]["friction_support"]
+    support = _force(load, x, v, 0.0, st)[2]["backward_support"]
     # the node-to-face contact's normal force (the edges' is frictionless)
     f_n = _ply_contact(x, v, load.slave, load.triangles, st.candidates.nodes, load.gap0, load.area,
                        contact.force_params(load)).force
     mass = jnp.full(len(nodes), 3e-7, jnp.float32)  # 0.3 kg/m² on 1e-6 m²
-    hook = jax.jit(lambda p, h: load.friction(support, p, mass, h, {}))
+    hook = jax.jit(lambda p, h: load.backward(support, p, mass, h, h, {}, None)[:2])
     p = mass[:, None] * v
     mu = float(load.params.friction)
     normal = float(np.sum(np.asarray(f_n)[upper & flat, 2]))
@@ -399,3 +401,27 @@ def test_a_strip_squeezed_between_plates_folds_into_layers_that_do_not_cross():
           f"{pairs_off} without")
     assert pairs_off > 0
     assert gap.min() >= -0.1 * h and pairs_on == 0
+
+
+def test_the_fold_s_normal_forces_integrated_backward_are_the_penalty_s_at_a_short_step_and_keep_momentum():
+    """``implicit_normal``: the node-to-face and edge-to-edge rows of a fold pressed to 0.9 h, solved
+    at the end of the step. At a step far below the contact's period they are the explicit penalty's
+    forces (normal damping off, nothing moving: the same sum on each layer within 1 %); at a long
+    one they are smaller, push the layers apart and keep momentum."""
+    nodes, x0, t = _fold(0.9 * H)
+    loads = {imp: dataclasses.replace(_load(x0, t, active_fraction=1.0), implicit_normal=imp) for imp in (False, True)}
+    x = jnp.asarray(nodes, jnp.float32)
+    v = jnp.zeros_like(x)
+    st = loads[True].initial_state(x)
+    upper = nodes[:, 2] > 0.5 * H
+    f_exp = np.asarray(_force(loads[False], x, v, 0.0, st)[0])
+    f0, _, ex = _force(loads[True], x, v, 0.0, st)
+    assert float(jnp.abs(f0).max()) == 0.0  # the force comes in the hook
+    mass = jnp.full(len(nodes), 3e-7, jnp.float32)
+    hook = jax.jit(lambda h: loads[True].backward(ex["backward_support"], jnp.zeros_like(x), mass, h, h, {}, None)[0])
+    f_short = np.asarray(hook(jnp.float32(1e-9)))
+    assert np.sum(f_short[upper, 2]) == pytest.approx(np.sum(f_exp[upper, 2]), rel=0.01)
+    assert np.sum(f_short[upper, 2]) > 0 and np.sum(f_short[~upper, 2]) < 0
+    f_long = np.asarray(hook(jnp.float32(1e-5)))  # k dt^2 / rho_A = 3: beyond the explicit limit
+    assert 0 < np.sum(f_long[upper, 2]) < np.sum(f_short[upper, 2])
+    np.testing.assert_allclose(f_long.sum(axis=0), 0.0, atol=1e-5 * np.abs(f_long).max())

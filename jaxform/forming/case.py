@@ -116,7 +116,7 @@ class ContactSpec:
     time step by :func:`jaxform.forming.numerics.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
     damping ratio; ``self_contact``: every ply with itself and the plies not next to it
     (:mod:`jaxform.self_contact`, on by default); ``expected_pressure``: Pa (``None``: automatic,
-    :func:`jaxform.forming.numerics.expected_pressure`)."""
+    :func:`jaxform.forming.numerics.expected_pressure`); ``implicit_normal``: normal forces backward (:mod:`jaxform.backward_normal`)."""
 
     penalty_stiffness: float | None
     safety: float | None
@@ -124,6 +124,7 @@ class ContactSpec:
     damping_ratio: float
     self_contact: bool = True
     expected_pressure: float | None = None
+    implicit_normal: bool = False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -190,7 +191,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
-                "self_contact": ("bool", False), "expected_pressure_Pa": ("auto", False)},
+                "self_contact": ("bool", False), "expected_pressure_Pa": ("auto", False), "implicit_normal": ("bool", False)},
     "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False),
                  "fibre_mass_momentum_term": ("bool", False)},
 }
@@ -376,7 +377,8 @@ def _build(d) -> Case:
                                       f"to {zeta_stable:.3g}" if zeta_stable < 1.0 else ""))
     contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=None if safety == "auto" else safety,
                                slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"],
-                               self_contact=c.get("self_contact", True), expected_pressure=None if pe == "auto" else pe)
+                               self_contact=c.get("self_contact", True), expected_pressure=None if pe == "auto" else pe,
+                               implicit_normal=c.get("implicit_normal", False))
 
     n = d["numerics"]
     if n["dtype"] not in ("float32", "float64"):
@@ -507,7 +509,8 @@ def to_dict(case: Case) -> dict:
         "contact": {"penalty_stiffness_Pa_per_m": "auto" if c.penalty_stiffness is None else c.penalty_stiffness,
                     "safety": "auto" if c.safety is None else c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
                     "damping_ratio": c.damping_ratio, "self_contact": c.self_contact,
-                    "expected_pressure_Pa": "auto" if c.expected_pressure is None else c.expected_pressure},
+                    "expected_pressure_Pa": "auto" if c.expected_pressure is None else c.expected_pressure,
+                    "implicit_normal": c.implicit_normal},
         "numerics": numerics,
     }
 

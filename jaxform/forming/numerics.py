@@ -161,6 +161,20 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
         return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
                                budget(float(dt), s_), "the time step was given")
     dt0 = dt_safety * stable
+    if c.implicit_normal:  # the contact takes nothing from the step (jaxform.backward_normal)
+        if case.holder.mode == "force" or case.n_plies > 1:
+            raise ValueError(
+                "contact.implicit_normal = true: not with a clamped holder (holder.mode = 'force') or a stack of "
+                f"plies (here {case.n_plies}): there contacts press nodes from both sides, where the backward "
+                "normal's local solve holds a penalty no stiffer than about rho_A / dt^2 (a clamped stack needs "
+                "about 9x that at the shell's step to keep 1e5 Pa within 0.1 h); use the explicit contact "
+                "(contact.implicit_normal = false, the default)")
+        s_ = (c.penalty_stiffness * dt0**2 / rho if c.penalty_stiffness is not None else
+              c.safety if c.safety is not None else max(k_need * dt0**2 / rho, (lim - w_s2 * dt0**2) / n_c, AUTO_SAFETY))
+        return ContactNumerics(dt0, s_, "shell", 0.5 * math.sqrt(w_s2) * dt0,
+                               f"step {dt_safety:g} x the shell's stable step; the contacts' normal forces integrated "
+                               f"backward (any stiffness stable): safety {s_:.3g} (penetration below "
+                               f"{MAX_PENETRATION:g} h at {p_exp:.3g} Pa, at least as stiff as the explicit contact)")
     if c.penalty_stiffness is not None:
         s_ = float(c.penalty_stiffness) * dt0**2 / rho
         return ContactNumerics(dt0, None, "shell", budget(dt0, s_), "the contact stiffness was given; "

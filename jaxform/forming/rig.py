@@ -296,7 +296,10 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     rho = float(np.max(np.asarray(fab0.areal_mass))) * float(case.mass_scaling)
     c = case.contact
     speed = float(case.process.speed)
-    common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=c.penalty_stiffness,
+    k = c.penalty_stiffness
+    if c.implicit_normal and k is None and safety is not None:  # any stiffness is stable: no bound on the safety
+        k = safety * rho / dt**2
+    common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=k,
                   expected_pressure=expected_pressure(case)[0],
                   damping_ratio=c.damping_ratio, safety=AUTO_SAFETY if safety is None else safety, interfaces=0)
     params_tool = penalty.contact_params(rho, dt, h, friction=float(fab0.friction_tool), **common)
@@ -308,7 +311,8 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     top = (ply_id == 1).astype(np.float64)
     bottom = (ply_id == case.n_plies).astype(np.float64)
     as_arr = lambda a: jnp.asarray(a, jdtype)  # noqa: E731
-    face = dict(params=params_tool, offset=as_arr(h / 2), area=as_arr(area))
+    imp = dict(implicit_normal=bool(c.implicit_normal))
+    face = dict(params=params_tool, offset=as_arr(h / 2), area=as_arr(area), **imp)
     punch = contact.ToolLoad(tool=tools_rig.punch, active=as_arr(top), **face)
     die = contact.ToolLoad(tool=tools_rig.die, active=as_arr(bottom), **face)
     holder_state = None
@@ -329,12 +333,12 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
         (a, b), (t0, t1) = mesh.ply_nodes[i], mesh.ply_tris[i + 1]
         loads.append(contact.PlyLoad(slave=jnp.asarray(np.arange(a, b), jnp.int32),
                                      triangles=jnp.asarray(tris[t0:t1], jnp.int32), gap0=as_arr(h),
-                                     area=as_arr(area[a:b]), params=params_ply, skin=as_arr(_skin(case))))
+                                     area=as_arr(area[a:b]), params=params_ply, skin=as_arr(_skin(case)), **imp))
     if c.self_contact:
         n = case.n_plies
         pair_ok = np.abs(np.arange(n + 1)[:, None] - np.arange(n + 1)[None, :]) != 1  # neighbours: PlyLoad
         loads.append(self_contact_load(mesh.nodes, tris, area, ply_id, h, params_ply, pair_ok=pair_ok,
-                                       skin=_skin(case), dtype=jdtype))
+                                       skin=_skin(case), dtype=jdtype, **imp))
     return tuple(loads), holder_state
 
 

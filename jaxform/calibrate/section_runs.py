@@ -134,15 +134,8 @@ class SectionRuns:
         todo = [k for k in dict.fromkeys(keys) if k not in self.cache]
         members = [(k, i) for k in todo for i in range(self.seeds)]
         chunks = [members[a:a + self.width] for a in range(0, len(members), self.width)]
-        if self.workers > 1 and len(chunks) > 1:
-            with ThreadPoolExecutor(min(self.workers, len(chunks))) as pool:
-                done = list(pool.map(self._chunk, chunks))
-        else:
-            done = [self._chunk(c) for c in chunks]
         out: dict = {}
-        for chunk, (y, v, ok, reach, runs, exact) in zip(chunks, done):
-            self.runs += runs
-            self.exact |= exact
+        for chunk, (y, v, ok, reach, *_) in zip(chunks, self._run(chunks)):
             for j, (k, _) in enumerate(chunk):
                 out.setdefault(k, []).append((y[j].astype(float), v[j], bool(ok[j]), float(reach[j])))
         for k, rs in out.items():
@@ -157,10 +150,21 @@ class SectionRuns:
         dz = jnp.asarray(imperfections(self.x0, self.seeds + n, self.amplitude, self.blank_size, self.clearance)[self.seeds:],
                          self.dtype)
         chunks = [[(_key(q), i) for i in range(a, min(a + self.width, n))] for a in range(0, n, self.width)]
-        with ThreadPoolExecutor(max(1, min(self.workers, len(chunks)))) as pool:
-            done = list(pool.map(lambda c: self._chunk(c, dz), chunks))
-        self.runs += sum(d[4] for d in done)
-        return [(y[j].astype(float), v[j], bool(ok[j])) for c, (y, v, ok, *_) in zip(chunks, done) for j in range(len(c))]
+        return [(y[j].astype(float), v[j], bool(ok[j])) for c, (y, v, ok, *_) in zip(chunks, self._run(chunks, dz))
+                for j in range(len(c))]
+
+    def _run(self, chunks, dz=None) -> list:
+        """:meth:`_chunk` of each batch, in a thread pool where there are several batches and workers;
+        the runs they took and the laws that needed the momentum term are counted."""
+        if self.workers > 1 and len(chunks) > 1:
+            with ThreadPoolExecutor(min(self.workers, len(chunks))) as pool:
+                done = list(pool.map(lambda c: self._chunk(c, dz), chunks))
+        else:
+            done = [self._chunk(c, dz) for c in chunks]
+        for d in done:
+            self.runs += d[4]
+            self.exact |= d[5]
+        return done
 
     def _chunk(self, chunk, dz=None):
         """One batch ``[(key, seed), ...]`` (``seed`` indexes ``dz``, default the fit's blanks): host

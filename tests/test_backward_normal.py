@@ -151,3 +151,34 @@ def test_force_controlled_holder_with_an_implicit_normal_carries_the_clamping_fo
     _, (rz, fz) = run(contact.HolderState())
     np.testing.assert_allclose(rz[-1], 1000.0, rtol=1e-3)
     np.testing.assert_allclose(fz[-1], -1000.0, rtol=1e-3)
+
+
+def test_where_two_rows_press_a_node_from_both_sides_the_penetration_grows_with_k_dt2():
+    """The limit the rig refuses a clamped stack for (jaxform.forming.numerics): a node on a floor
+    row, pressed down by a second row from a wall a force ``f`` pushes (a damped mass), both rows
+    solved together, settles with each row's penetration ``(1 + 2 beta) f / (A k)`` (``beta = k
+    dt^2 / rho_A``; each row holds half the node's mass, and neither sees the other's force in its
+    trial), not the penalty's ``f / (A k)``: for ``beta >> 1`` the contact holds no stiffer than
+    about ``rho_A / (2 dt^2)``. The forces themselves are right: ``f`` on each row."""
+    dt, f, mw = 1e-5, 1e-3, 1000 * M
+    normals = jnp.array([[0.0, 0.0, 1.0], [0.0, 0.0, -1.0]])
+
+    def settle(k):
+        def body(s, _):
+            z, v, wall, vw = s
+            F, force = backward_normal.row_forces(jnp.array([[0.0, 0.0, M * v]]), jnp.array([M]), dt, dt,
+                                                  jnp.zeros((2, 1), int), jnp.ones((2, 1)), normals,
+                                                  jnp.stack([z, wall - z - H]), jnp.full(2, AREA), k, 0.0,
+                                                  jnp.array([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0]]) * vw)
+            v = v + dt * force[0, 2] / M
+            vw = vw + dt * (F[1] - f - 2 * jnp.sqrt(k * AREA * mw) * vw) / mw  # the wall, critically damped
+            return (z + dt * v, v, wall + dt * vw, vw), F
+
+        s, F = jax.lax.scan(body, (0.0, 0.0, H, 0.0), None, length=20000)
+        return s[0], F[-1]
+
+    for beta in (0.1, 1.0, 10.0):
+        k = beta * RHO_A / dt**2
+        z, F = jax.jit(settle)(k)
+        assert np.asarray(F) == pytest.approx([f, f], rel=1e-4)
+        assert -float(z) * AREA * k / f == pytest.approx(1 + 2 * beta, rel=1e-3)

@@ -154,21 +154,21 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
     def budget(dt_, s_):
         return 0.5 * math.sqrt(w_s2 * dt_**2 + n_c * s_)
 
+    if c.implicit_normal and (case.holder.mode == "force" or case.n_plies > 1):
+        raise ValueError(
+            "contact.implicit_normal = true: not with a clamped holder (holder.mode = 'force') or a stack of "
+            f"plies (here {case.n_plies}): there contacts press nodes from both sides, where the backward "
+            "normal's local solve holds a penalty no stiffer than about rho_A / dt^2 (a clamped stack needs "
+            "about 9x that at the shell's step to keep 1e5 Pa within 0.1 h); use the explicit contact "
+            "(contact.implicit_normal = false, the default)")
     if dt is not None:
         s_ = c.safety if c.safety is not None else AUTO_SAFETY
         if c.penalty_stiffness is not None:
             s_ = float(c.penalty_stiffness) * float(dt) ** 2 / rho
         return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
-                               budget(float(dt), s_), "the time step was given")
+                               budget(float(dt), 0.0 if c.implicit_normal else s_), "the time step was given")
     dt0 = dt_safety * stable
     if c.implicit_normal:  # the contact takes nothing from the step (jaxform.backward_normal)
-        if case.holder.mode == "force" or case.n_plies > 1:
-            raise ValueError(
-                "contact.implicit_normal = true: not with a clamped holder (holder.mode = 'force') or a stack of "
-                f"plies (here {case.n_plies}): there contacts press nodes from both sides, where the backward "
-                "normal's local solve holds a penalty no stiffer than about rho_A / dt^2 (a clamped stack needs "
-                "about 9x that at the shell's step to keep 1e5 Pa within 0.1 h); use the explicit contact "
-                "(contact.implicit_normal = false, the default)")
         s_ = (c.penalty_stiffness * dt0**2 / rho if c.penalty_stiffness is not None else
               c.safety if c.safety is not None else max(k_need * dt0**2 / rho, (lim - w_s2 * dt0**2) / n_c, AUTO_SAFETY))
         return ContactNumerics(dt0, s_, "shell", 0.5 * math.sqrt(w_s2) * dt0,

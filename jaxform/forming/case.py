@@ -26,7 +26,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                (0, 1): (omega_c dt)^2 of one contact, see jaxform.forming.rig), slip_velocity_fraction,
                damping_ratio, optional self_contact (default true: folds lie on themselves),
                optional expected_pressure_Pa ("auto", the default, or > 0: the contact pressure
-               the penalty keeps below 10% of the ply, jaxform.forming.numerics.expected_pressure)
+               the penalty keeps below 10% of the ply, jaxform.forming.numerics.expected_pressure),
+               optional implicit_normal (default false; true: jaxform.backward_normal, one ply, a gap holder)
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto", the
                default: jaxform.forming.numerics.auto_fibre_mass; or a number >= 1, 1 = off:
                inertia added to fibre stretching only, the membrane limit of the step grows by
@@ -99,8 +100,7 @@ class HolderSpec:
 
 @dataclasses.dataclass(frozen=True)
 class ProcessSpec:
-    """Punch stroke m (from first contact), simulated speed m/s, speed ramp as a fraction of the
-    stroke time, number of output frames."""
+    """Punch stroke m (from first contact), simulated speed m/s, speed ramp (fraction of the stroke time), frames."""
 
     stroke: float
     speed: float

@@ -78,7 +78,9 @@ def test_case_b_plies_stay_in_contact_and_the_holder_holds_1000_N(fabric):
         assert key in r.summary
 
 
-def test_gradients_of_a_short_run_match_finite_differences():
+# and with the contacts' normal forces integrated backward (another compiled reverse program: -m slow)
+@pytest.mark.parametrize("implicit", [False, pytest.param(True, marks=pytest.mark.slow)])
+def test_gradients_of_a_short_run_match_finite_differences(implicit):
     """d(output)/d(b_inf, first shear coefficient) of a 3 mm stroke by reverse mode, float64,
     against central differences: the output is the mean sag (mm) of the blank inside r = 70 mm plus
     the mean squared displacement, each divided by its value at the start.
@@ -89,7 +91,8 @@ def test_gradients_of_a_short_run_match_finite_differences():
     lags one step), above the float64 blow-up floor of 1e-8 J (a stable run: the balance then
     stays below 0.3% of the energies)."""
     case = _coarse("case-a-woven-nlbm", process__stroke_mm=3, process__frames=2, process__speed_mm_per_s=2000.0,
-                   numerics__dtype='"float64"', contact__self_contact="false", contact__safety=0.1)
+                   numerics__dtype='"float64"', contact__self_contact="false", contact__safety=0.1,
+                   contact__implicit_normal=str(implicit).lower())
     model, state, info = forming.build(case, samples_per_frame=1)
     fab = model.shell.fabrics[0]
     law = fab.bending[0]

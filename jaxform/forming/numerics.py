@@ -168,9 +168,9 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
         return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
                                budget(float(dt), 0.0 if c.implicit_normal else s_), "the time step was given")
     dt0 = dt_safety * stable
-    if c.implicit_normal:  # the contact takes nothing from the step (jaxform.backward_normal)
+    if c.implicit_normal and c.safety is None:  # the contact takes nothing from the step (jaxform.backward_normal)
         s_ = (c.penalty_stiffness * dt0**2 / rho if c.penalty_stiffness is not None else
-              c.safety if c.safety is not None else max(k_need * dt0**2 / rho, (lim - w_s2 * dt0**2) / n_c, AUTO_SAFETY))
+              max(k_need * dt0**2 / rho, (lim - w_s2 * dt0**2) / n_c, AUTO_SAFETY))
         return ContactNumerics(dt0, s_, "shell", 0.5 * math.sqrt(w_s2) * dt0,
                                f"step {dt_safety:g} x the shell's stable step; the contacts' normal forces integrated "
                                f"backward (any stiffness stable): safety {s_:.3g} (penetration below "
@@ -182,7 +182,8 @@ def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_sa
     if c.safety is not None:  # the user's safety: the step capped so that k >= k_need
         dt_c = 0.98 * math.sqrt(c.safety * rho / k_lim)
         dt_ = min(dt0, dt_c)
-        return ContactNumerics(dt_, c.safety, "shell" if dt0 <= dt_c else "contact", budget(dt_, c.safety),
+        return ContactNumerics(dt_, c.safety, "shell" if dt0 <= dt_c else "contact",
+                               budget(dt_, 0.0 if c.implicit_normal else c.safety),
                                f"contact.safety = {c.safety:g} was given")
     s_need = k_need * dt0**2 / rho
     s_room = (lim - w_s2 * dt0**2) / n_c

@@ -11,11 +11,11 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
-
 from jaxform import cases, forming
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from energy_balance import balance  # noqa: E402  (benchmarks/)
 from jaxform.forming import rig
-from jaxform.forming.fields import ENERGY_KEYS
 from jaxform.forming.summary import shear_mirror_odd, symmetry_error
 
 out = Path(sys.argv[1])
@@ -24,18 +24,6 @@ case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 4e-3)
 model, _, _ = rig.build(case)
 k = float(model.loads[0].params.stiffness)
 off = cases.apply_overrides(case, ["numerics.fibre_mass_scaling=1", f"contact.penalty_stiffness_Pa_per_m={k}"])
-
-
-def balance(r):
-    e = {key: np.asarray(r.summary["history"]["energies_J"][key]) for key in ENERGY_KEYS}
-    stored = e["kinetic"] + e["tension"] + e["shear"] + e["bending"]
-    work = e["gravity_work"] + e["external_work"] + e["boundary_work"] - e["damping_work"]
-    res = (stored - stored[0]) - (work - work[0])
-    scale = np.max(np.abs(stored) + np.abs(e["gravity_work"]) + np.abs(e["external_work"]) + np.abs(e["boundary_work"])
-                   + np.abs(e["damping_work"]))
-    return {"max_abs_residual_J": float(np.max(np.abs(res))), "end_residual_J": float(res[-1]),
-            "max_scale_J": float(scale), "max_rel": float(np.max(np.abs(res)) / scale),
-            "net_work_end_J": float(work[-1] - work[0])}
 
 
 rec = {"contact_stiffness_Pa_per_m": k}

@@ -13,23 +13,14 @@ from pathlib import Path
 import numpy as np
 
 from jaxform import cases, forming
-from jaxform.forming.fields import ENERGY_KEYS
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2]))
+from energy_balance import balance  # noqa: E402  (benchmarks/)
 
 name, mm, out = sys.argv[1], float(sys.argv[2]), Path(sys.argv[3])
 out.mkdir(parents=True, exist_ok=True)
 case = cases.with_element_size(cases.load(name), mm * 1e-3)
 implicit = cases.apply_overrides(case, ["contact.implicit_normal=true"])
-
-
-def balance(r):
-    e = {key: np.asarray(r.summary["history"]["energies_J"][key]) for key in ENERGY_KEYS}
-    stored = e["kinetic"] + e["tension"] + e["shear"] + e["bending"]
-    work = e["gravity_work"] + e["external_work"] + e["boundary_work"] - e["damping_work"]
-    res = (stored - stored[0]) - (work - work[0])
-    scale = np.max(np.abs(stored) + np.abs(e["gravity_work"]) + np.abs(e["external_work"]) + np.abs(e["boundary_work"])
-                   + np.abs(e["damping_work"]))
-    return {"max_abs_residual_J": float(np.max(np.abs(res))), "max_rel": float(np.max(np.abs(res)) / scale),
-            "net_work_end_J": float(work[-1] - work[0])}
 
 
 rec, res = {"preset": name, "element_size_mm": mm}, {}

@@ -304,12 +304,9 @@ def test_a_spinning_sheet_keeps_its_energy_only_with_the_position_dependent_mass
     assert "numerics.fibre_mass_momentum_term = true" in str(err.value)  # the failure names the remedy
 
 
-def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
-    """A forming run whose blank spins in-plane and stretches (NCF, 25 mm, fibre mass 12 without
-    its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792) is
-    run again from its start with it, the run completes, and the summary says from which step and
-    why. The same rig at rest never pays for the term. Batched together, each member gets what its
-    own run gave."""
+def _spun_ncf_rig():
+    """NCF Case A on 25 mm elements, fibre mass 12 without its term, float64: ``(rig at rest, the
+    same rig spinning in-plane and stretching)``."""
     import dataclasses
 
     from jaxform import cases, forming
@@ -326,7 +323,20 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     p = np.where(np.asarray(model.fixed), 0.0, np.asarray(model.mass)[:, None] * v).T
     e = dataclasses.replace(state.energies, kinetic=jnp.asarray(0.5 * np.sum(np.asarray(model.mass) * np.sum(v**2, 1))))
     spun = dataclasses.replace(state, v=jnp.asarray(v), momentum=jnp.asarray(p), energies=e, scale_max=e.scale())
-    res = forming.run(forming.Rig(model, spun, info), catch=True)
+    return forming.Rig(model, state, info), forming.Rig(model, spun, info)
+
+
+def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
+    """A forming run whose blank spins in-plane and stretches (NCF, 25 mm, fibre mass 12 without
+    its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792) is
+    run again from its start with it, the run completes, and the summary says from which step and
+    why. The same rig at rest never pays for the term. Batched: the slow test below."""
+    from jaxform import forming
+
+    calm_rig, spun_rig = _spun_ncf_rig()
+    model, info = calm_rig.model, calm_rig.info
+    assert model.fibre_mass is not None and not model.fibre_mass.geometric
+    res = forming.run(spun_rig, catch=True)
     assert res.complete, res.reason
     sw = res.momentum_term_from
     assert sw is not None and 0 < sw["step"] < info.n_steps and "energy" in sw["cause"]
@@ -334,14 +344,24 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     n = res.summary["numerics"]
     assert n["fibre_mass_momentum_term"] and n["fibre_mass_momentum_term_from_step"] == sw["step"]
     assert "switched on by the driver" in n["fibre_mass_momentum_term_choice"]
-    calm = forming.run(forming.Rig(model, state, info), catch=True)
+    calm = forming.run(calm_rig, catch=True)
     assert calm.complete and calm.momentum_term_from is None and not calm.model.fibre_mass.geometric
     assert calm.summary["numerics"]["fibre_mass_momentum_term_choice"].startswith("off")
-    # a batch of the two (one program) gives each member what its own run gave: the spun one goes
-    # on alone with the term from the same step, the calm one never switches
+
+
+@pytest.mark.slow
+def test_batched_the_spun_member_turns_the_momentum_term_on_alone():
+    """The test above as a batch of the two rigs (one program; slow: two more compiled forming
+    programs, about 25 s of the default run): each member gets what its own run gave, the spun one
+    goes on alone with the term from the same step, the calm one never switches."""
+    from jaxform import forming
     from jaxform.forming import batch
 
-    spun_b, calm_b = batch.run_part([forming.Rig(model, spun, info), forming.Rig(model, state, info)])
+    calm_rig, spun_rig = _spun_ncf_rig()
+    res = forming.run(spun_rig, catch=True)
+    sw = res.momentum_term_from
+    assert res.complete and sw is not None, res.reason
+    spun_b, calm_b = batch.run_part([spun_rig, calm_rig])
     assert spun_b.complete and calm_b.complete, (spun_b.reason, calm_b.reason)
     assert spun_b.momentum_term_from["step"] == sw["step"] and spun_b.model.fibre_mass.geometric
     assert spun_b.summary["numerics"]["fibre_mass_momentum_term_from_step"] == sw["step"]

@@ -259,21 +259,26 @@ def test_a_given_contact_safety_that_breaks_the_step_budget_is_warned_about():
     assert auto.budget <= 0.9 + 1e-9
 
 
+_CUT_CASE = _coarse("case-a-woven-nlbm", **{"process.stroke_mm": 4, "process.frames": 3, "contact.expected_pressure_Pa": 1e2})
+
+
+def _cut_rig():
+    """:data:`_CUT_CASE` at twice the automatic step's safety (1.64x the stable estimate)."""
+    with pytest.warns(RuntimeWarning, match="above the estimated stable limit"):
+        return forming.build(_CUT_CASE, dt_safety=2.0)
+
+
 def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
     """The driver's step cut (``driver.MAX_STEP_CUT``): a 25 mm rig whose automatic step is 1.64x
     its stable estimate (``dt_safety = 2``) grows an unstable mode and fails at step 21 of 600
     (measured); the driver runs that chunk again from its start with half the step, and the rest
     of the run too: the run completes, its summary says where and why, and it forms the part as the
-    run at the usual step does (draw-in within 1 %). Run as a batch of one, the member goes on
-    alone with the same cut. A step the user gives is never cut
-    (``test_cli_run.test_failed_run_keeps_its_frames_and_says_why``)."""
-    from jaxform.forming import batch, driver
+    run at the usual step does (draw-in within 1 %). As a batch member: the slow test below. A step
+    the user gives is never cut (``test_cli_run.test_failed_run_keeps_its_frames_and_says_why``)."""
+    from jaxform.forming import driver
 
-    case = _coarse("case-a-woven-nlbm", **{"process.stroke_mm": 4, "process.frames": 3,
-                                           "contact.expected_pressure_Pa": 1e2})
-    usual = forming.run(forming.build(case), catch=True)
-    with pytest.warns(RuntimeWarning, match="above the estimated stable limit"):
-        rig = forming.build(case, dt_safety=2.0)
+    usual = forming.run(forming.build(_CUT_CASE), catch=True)
+    rig = _cut_rig()
     assert rig.info.numerics.governed_by == "shell" and rig.info.dt > 1.5 * rig.info.stable_dt
     cut = forming.run(rig, catch=True)
     assert usual.complete and cut.complete, (usual.reason, cut.reason)
@@ -287,8 +292,18 @@ def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
     d_usual, d_cut = usual.summary["draw_in"]["edge_mid_m"], cut.summary["draw_in"]["edge_mid_m"]
     assert d_usual > 1e-4 and abs(d_cut / d_usual - 1.0) < 0.01, (d_usual, d_cut)
     assert driver.MAX_STEP_CUT == 8
+
+
+@pytest.mark.slow
+def test_a_batch_member_whose_chunk_fails_at_the_automatic_step_runs_again_with_half_of_it_alone():
+    """The test above as a batch of one (slow: another compiled forming program, about 10 s of the
+    default run): the member goes on alone with the same cut as its own run."""
+    from jaxform.forming import batch
+
+    rig = _cut_rig()
+    cut = forming.run(rig, catch=True)
     (member,) = batch.run_part([rig])
-    assert member.complete and member.step_cuts == cut.step_cuts, (member.reason, member.step_cuts)
+    assert cut.complete and member.complete and member.step_cuts == cut.step_cuts, (member.reason, member.step_cuts)
 
 
 def _clamped_soft():

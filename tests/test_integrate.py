@@ -114,9 +114,10 @@ def test_gravity_damping_and_fixed_nodes_settle_to_rest_with_balanced_energy():
 
 
 def test_checkpointed_and_plain_rollouts_agree_and_differentiate():
-    """20 steps as 5 checkpointed frames of 4 (segments of 2, none left), as 4 of 5 (a segment of
-    3, 2 left) and as 5 plain frames of 4: the same loss, frames and gradient (three programs:
-    both segment paths against one plain rollout)."""
+    """20 steps as 4 checkpointed frames of 5 (two segments of 3, the first skipping a step) and as
+    5 plain frames of 4: the same loss, frames and gradient. As 5 checkpointed frames of 4 (two
+    segments of 2, none skipped) the same loss and frames (forward only: its reverse program, a
+    scan's remat with no step skipped, cost 20 s of the default run)."""
     mesh, shell = _plate()
     model = make_model(shell)
 
@@ -130,9 +131,11 @@ def test_checkpointed_and_plain_rollouts_agree_and_differentiate():
     vg = jax.jit(jax.value_and_grad(loss, has_aux=True), static_argnums=(1, 2, 3))
     (l0, ex0), g0 = vg(1.0, 5, 4, False)
     assert g0 != 0.0
-    for n_frames, every in ((5, 4), (4, 5)):
-        (l1, ex1), g1 = vg(1.0, n_frames, every, True)
-        np.testing.assert_allclose(l1, l0, rtol=1e-12)
-        np.testing.assert_allclose(g1, g0, rtol=1e-10)
-        last = (lambda a: a[-1]) if every != 4 else (lambda a: a)  # frames of 5 steps: the last is step 20 too
-        jax.tree_util.tree_map(lambda a, b: np.testing.assert_allclose(last(a), last(b), rtol=1e-12), ex1, ex0)
+    (l1, ex1), g1 = vg(1.0, 4, 5, True)
+    np.testing.assert_allclose(l1, l0, rtol=1e-12)
+    np.testing.assert_allclose(g1, g0, rtol=1e-10)
+    # frames of 5 steps: the last is step 20 too
+    jax.tree_util.tree_map(lambda a, b: np.testing.assert_allclose(a[-1], b[-1], rtol=1e-12), ex1, ex0)
+    l2, ex2 = jax.jit(loss, static_argnums=(1, 2, 3))(1.0, 5, 4, True)
+    np.testing.assert_allclose(l2, l0, rtol=1e-12)
+    jax.tree_util.tree_map(lambda a, b: np.testing.assert_allclose(a, b, rtol=1e-12), ex2, ex0)

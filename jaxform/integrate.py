@@ -268,8 +268,9 @@ def run_steps(model: Model, state: State, n: int, *, e0: Energies | None = None,
 
     A stretch in which a step fails returns its starting state (the last good one) with the
     failing step recorded in ``bad_step``/``bad_code``. ``segment``: the steps run as checkpointed
-    segments of that many (the first one shorter where ``segment`` does not divide ``n``), so that reverse mode stores a state per segment
-    and one segment's steps, not every step's intermediates (same forward result).
+    segments of that many (the first one shorter where ``segment`` does not divide ``n``), so that
+    reverse mode stores a state per segment and one segment's steps, not every step's intermediates
+    (same forward result).
     """
     x_ref = model.drive.position(0.0) if x_ref is None else x_ref
     e0 = state.energies if e0 is None else e0

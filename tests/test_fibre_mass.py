@@ -352,7 +352,7 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
 @pytest.mark.slow
 def test_batched_the_spun_member_turns_the_momentum_term_on_alone():
     """The test above as a batch of the two rigs (one program; slow: two more compiled forming
-    programs, about 25 s of the default run): each member gets what its own run gave, the spun one
+    programs, about 28 s of the default run): each member gets what its own run gave, the spun one
     goes on alone with the term from the same step, the calm one never switches."""
     from jaxform import forming
     from jaxform.forming import batch

@@ -259,7 +259,8 @@ def test_a_given_contact_safety_that_breaks_the_step_budget_is_warned_about():
     assert auto.budget <= 0.9 + 1e-9
 
 
-_CUT_CASE = _coarse("case-a-woven-nlbm", **{"process.stroke_mm": 4, "process.frames": 3, "contact.expected_pressure_Pa": 1e2})
+_CUT_CASE = _coarse("case-a-woven-nlbm", **{"process.stroke_mm": 4, "process.frames": 3,
+                                            "contact.expected_pressure_Pa": 1e2})
 
 
 def _cut_rig():
@@ -296,7 +297,7 @@ def test_a_chunk_that_fails_at_the_automatic_step_runs_again_with_half_of_it():
 
 @pytest.mark.slow
 def test_a_batch_member_whose_chunk_fails_at_the_automatic_step_runs_again_with_half_of_it_alone():
-    """The test above as a batch of one (slow: another compiled forming program, about 10 s of the
+    """The test above as a batch of one (slow: another compiled forming program, about 20 s of the
     default run): the member goes on alone with the same cut as its own run."""
     from jaxform.forming import batch
 

@@ -117,7 +117,7 @@ def test_checkpointed_and_plain_rollouts_agree_and_differentiate():
     """20 steps as 4 checkpointed frames of 5 (two segments of 3, the first skipping a step) and as
     5 plain frames of 4: the same loss, frames and gradient. As 5 checkpointed frames of 4 (two
     segments of 2, none skipped) the same loss and frames (forward only: its reverse program, a
-    scan's remat with no step skipped, cost 20 s of the default run)."""
+    scan's remat with no step skipped, cost about 20 s of the default run)."""
     mesh, shell = _plate()
     model = make_model(shell)
 

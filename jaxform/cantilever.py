@@ -287,12 +287,8 @@ def _is_traced(tree) -> bool:
     return any(isinstance(leaf, jax.core.Tracer) for leaf in jax.tree_util.tree_leaves(tree))
 
 
-GRADING = 20.0
-"""The strip mesh's default clamp grading (last / first element length; module docstring)."""
-
-
 def simulate(bending, *, overhang: float, areal_mass, width: float | None = None, n_elements: int = 40,
-             n_width: int = 2, grading: float = GRADING, cross_bending=None, thickness=3e-4, fibre_modulus=3.0e9, shear=None,
+             n_width: int = 2, grading: float = 20.0, cross_bending=None, thickness=3e-4, fibre_modulus=3.0e9, shear=None,
              g: float = GRAVITY, load_steps: int = 8, stiffen_steps: int = 3, max_iter: int = 40,
              tol: float | None = None) -> CantileverResult:
     """Solve the hanging strip to rest with the shell; return its side profile and tip angle.
@@ -388,8 +384,6 @@ class StandardTestResult:
         residual: the cantilever solver's relative out-of-balance force at ``overhang_41_5``.
         max_residual: the largest such residual over every strip the search solved.
         n_simulations: strips solved by the search.
-        grading: the strip mesh's clamp grading the result rests on (:data:`FALLBACK_GRADINGS`;
-            None with a model of the caller's).
     """
 
     overhang_41_5: Any
@@ -398,7 +392,6 @@ class StandardTestResult:
     residual: Any = None
     max_residual: Any = None
     n_simulations: Any = None
-    grading: Any = None
 
 
 class CantileverNotConverged(RuntimeError):
@@ -417,18 +410,6 @@ def chord_angle(profile):
 MAX_RETREATS = 6
 """Times :func:`standard_test` shortens a strip that does not solve before it gives up."""
 
-FALLBACK_GRADINGS = (10.0, 5.0)
-"""Milder clamp gradings than :data:`GRADING` on which :func:`standard_test`
-searches again where strips on the default mesh do not solve. The NCF's negative Voce law (``b_inf``
-1.03e-4 N·m, ``B_init`` 5.7e-3 N·m) hangs near its 41.5° overhang (159 mm) with a hinge at the
-clamp, and there no strip whose clamp elements are shorter than about 1 mm solved (grading 20 at 40
-elements, 5 at 80, 10 at 80, 20 at 160: the damped Newton ends far from equilibrium; cause not
-found), while grading 10 and 5 at 40 did (chord angle at 159 mm 41.56° and 41.47°, 3: 41.36°).
-Whether the default mesh solves depends on rounding: with the test suite's XLA flags its search
-did (B_41.5 2.164e-3 N·m; grading 10 2.166e-3, 5 2.170e-3). On the NCF's positive law, which
-solves on every mesh, grading 10 moves ``B_41.5`` by +0.08 % and 5 by +0.25 % from 20 (measured
-2026-12-06)."""
-
 
 def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float = 1e-5, max_iter: int = 30,
                   max_residual: float = 1e-5, model=None, **kwargs) -> StandardTestResult:
@@ -444,28 +425,10 @@ def standard_test(bending, *, areal_mass: float, g: float = GRAVITY, tol: float 
     overhang when that does not help, or when the secant search has not met ``tol`` (relative,
     on the overhang) after ``max_iter`` steps. ``model``: the forward model
     (default the shell, :func:`simulate` with gravity ``g``; another model with the same signature
-    keeps its own gravity and may report no ``residual``). ``kwargs`` go to the model. With the
-    default model and mesh grading, a search whose strips do not solve runs again on the milder
-    gradings :data:`FALLBACK_GRADINGS` (the result's ``grading`` says which mesh it rests on); the
-    error names every mesh tried when none does.
+    keeps its own gravity and may report no ``residual``). ``kwargs`` go to the model.
     """
-    if model is not None or "grading" in kwargs:
-        return _search(bending, areal_mass, g, tol, max_iter, max_residual, model, kwargs)
-    errors = []
-    for grading in (None, *FALLBACK_GRADINGS):
-        kw = kwargs if grading is None else dict(kwargs, grading=grading)
-        try:
-            return _search(bending, areal_mass, g, tol, max_iter, max_residual, None, kw)
-        except CantileverNotConverged as err:
-            errors.append(f"grading {kw.get('grading', GRADING):g}: {err}")
-    raise CantileverNotConverged("; ".join(errors))
-
-
-def _search(bending, areal_mass, g, tol, max_iter, max_residual, model, kwargs) -> StandardTestResult:
-    """:func:`standard_test`'s search with one model and mesh."""
     from jaxform.materials import max_stiffness
 
-    grading = None if model is not None else float(kwargs.get("grading", GRADING))
     model = functools.partial(simulate, g=g) if model is None else model
     w = float(areal_mass) * g
     b0 = float(np.max(np.asarray(max_stiffness(bending))))
@@ -508,8 +471,8 @@ def _search(bending, areal_mass, g, tol, max_iter, max_residual, model, kwargs) 
             f"(last overhangs {1e3 * L0:.4f}, {1e3 * L1:.4f} mm, chord angle off by {math.degrees(f1):+.3g} deg)")
     c = 0.5 * L1
     return StandardTestResult(overhang_41_5=L1, bending_length=c, b_41_5=w * c**3, residual=log[-1][2],
-                              max_residual=max(e[2] for e in log), n_simulations=len(log), grading=grading)
+                              max_residual=max(e[2] for e in log), n_simulations=len(log))
 
 
-__all__ = ["simulate", "standard_test", "MAX_RETREATS", "GRADING", "FALLBACK_GRADINGS", "chord_angle",
-           "CantileverResult", "StandardTestResult", "CantileverNotConverged", "GRAVITY", "PEIRCE_ANGLE"]
+__all__ = ["simulate", "standard_test", "MAX_RETREATS", "chord_angle", "CantileverResult", "StandardTestResult",
+           "CantileverNotConverged", "GRAVITY", "PEIRCE_ANGLE"]

@@ -124,6 +124,21 @@ def test_standard_test_raises_when_the_solver_does_not_converge():
         standard_test(LinearBending(B), areal_mass=RHO, n_elements=N, max_residual=1e-30)
 
 
+@pytest.mark.slow
+def test_standard_test_of_the_ncf_negative_law_gives_table_1_less_32_percent():
+    """The NCF's negative Voce law, whose strips near the 41.5° overhang did not solve with the
+    fibres softened 1e-4 during loading (:data:`jaxform.cantilever.FIBRE_SOFTENING`): B_41.5 is 32 %
+    below Table 1's 3.2e-3 N·m (issue 15's known figure; measured 2.164e-3 N·m), every strip at
+    equilibrium; a milder clamp grading (5) agrees within 0.5 % (measured +0.3 %)."""
+    from jaxform.materials import NCF_FCIM359
+
+    neg, m = NCF_FCIM359.bending[0].neg, float(NCF_FCIM359.areal_mass)
+    res = standard_test(neg, areal_mass=m)
+    assert float(res.b_41_5) / 3.2e-3 - 1 == pytest.approx(-0.32, abs=0.01) and float(res.max_residual) <= 1e-5
+    coarse = standard_test(neg, areal_mass=m, grading=5.0)
+    assert float(coarse.b_41_5) == pytest.approx(float(res.b_41_5), rel=5e-3)
+
+
 def test_bad_overhang_is_rejected():
     with pytest.raises(ValueError, match="overhang"):
         simulate(LinearBending(B), overhang=0.0, areal_mass=RHO)

@@ -83,7 +83,7 @@ def standard_tests(fabrics, cache_path: pathlib.Path | None = None) -> dict:
         for side, sub, table in zip(("pos", "neg"), sides, fab.measured_b41_5):
             key = f"{label} {side}" if len(sides) == 2 else label
             ck = cache_key(sub, fab.areal_mass)
-            if ck not in cache:
+            if cache.get(ck, {}).get("simulated") is None:  # not run, or failed (perhaps with older code): run
                 try:
                     with jax.enable_x64(True):
                         st = cantilever.standard_test(sub, areal_mass=float(fab.areal_mass))

@@ -293,10 +293,11 @@ FIBRE_SOFTENING = 1e-2
 N·m, ``B_init`` 5.7e-3 N·m, a hinge at the clamp) did not solve near its 41.5° overhang (159 mm)
 on any mesh with clamp elements shorter than about 1 mm (grading 20 at 40 and 160 elements, 5 at
 80; 8 or 16 stiffening steps did not help): the soft-fibre strip sagged to a chord of 54-83° and
-the damped Newton ended there, 1e2-1e5 times the weight out of balance. At 1e-2 every one of them
-solves (41.59° at grading 20, 58 iterations; gradings 10 and 5 took 48 at 1e-4), and the strips
-that solved before give the same result (B_41.5 of the woven law to 1e-15, of the NCF's positive
-law to 2e-8); at 1 (no softening) they solve in 2-3x the iterations."""
+the damped Newton ended there, 1e2-1e5 times the weight out of balance. At 1e-2 the ones retried
+solve (grading 20 at 40 elements and 5 at 80, at 159 and 200 mm; 41.59° at 159 mm and grading 20,
+58 iterations, where gradings 10 and 5 at 40 took 48 at 1e-4), and the strips that solved before
+give the same result (B_41.5 of the woven law to 1e-15, of the NCF's positive law to 2e-8); at 1
+(no softening) they solve in 2-3x the iterations."""
 
 
 def simulate(bending, *, overhang: float, areal_mass, width: float | None = None, n_elements: int = 40,

@@ -69,8 +69,8 @@ def test_spectral_bound_holds_for_any_fibre_directions_and_is_not_loose():
         op = jax.jit(lambda v, units=units: x * F.stiffness_times(v / jnp.sqrt(m), units, fm, shell) / jnp.sqrt(m))
         lams[name] = _largest_eigenvalue(op, m.shape[:0] + (3, m.shape[1]))
         assert lams[name] <= x * (1 + 1e-9), name
-    # X is reached where each family's differences lie along it; closer as the families align
-    # (measured on this mesh: 0.58 X at the reference, 0.885 X sheared 50 degrees, 0.878 X random;
+    # X is reached where both families run in one direction; closer as they align (measured on
+    # this mesh: 0.58 X at the reference, 0.885 X sheared 50 degrees, 0.878 X random;
     # the block Gershgorin bound used before: 0.51, 0.78, 0.77 of its own X)
     assert lams["sheared 50 deg"] >= 0.85 * x
 

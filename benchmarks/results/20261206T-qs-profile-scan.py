@@ -36,3 +36,5 @@ for ((t, d), q), (y, v, ok, reach) in zip(pts.items(), evs):
 out["forming_runs"] = runs.runs
 out["wall_s"] = time.perf_counter() - t0
 json.dump(out, open(sys.argv[1], "w"), indent=1)
+if not all(r["ok"] for r in out["points"]):
+    sys.exit(f"{sys.argv[0]}: a forming run failed (ok false in {sys.argv[1]})")

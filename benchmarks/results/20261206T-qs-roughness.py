@@ -23,3 +23,5 @@ out = {k: {"q": list(map(float, q)), "loss": float(l)} for (k, q), l in zip(pts.
 out["wall_s"] = time.perf_counter() - t0
 print(json.dumps(out, indent=1))
 json.dump(out, open(sys.argv[1], "w"), indent=1)
+if not np.all(np.isfinite(losses)):
+    sys.exit(f"{sys.argv[0]}: a forming run failed (an infinite loss in the output)")

@@ -25,3 +25,5 @@ out = {"dtype": dtype, "sections_s": t1 - t0, "losses_s": time.perf_counter() - 
        "points": {k: {"q": list(map(float, q)), "loss": float(l)} for (k, q), l in zip(pts.items(), losses)}}
 print(json.dumps(out, indent=1), flush=True)
 json.dump(out, open(sys.argv[2], "w"), indent=1)
+if not np.all(np.isfinite(losses)):
+    sys.exit(f"{sys.argv[0]}: a forming run failed (an infinite loss in the output)")

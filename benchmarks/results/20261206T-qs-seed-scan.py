@@ -37,13 +37,16 @@ for j, (k, q) in enumerate(pts.items()):
     valid = np.all([d[1][0] for d in ys], axis=0)
     row = {"q": list(map(float, q)), "ok": ok}
     for w in W:
-        per = [0.5 * float(np.sum((Rs[w] @ np.where(valid, d[0][0].astype(float) - meas, 0.0)) ** 2)) for d in ys]
+        per = [0.5 * float(np.sum((Rs[w] @ np.where(valid, d[0][0].astype(float) - meas, 0.0)) ** 2)) if d[2][0] else None
+               for d in ys]
         ym = np.mean([d[0][0].astype(float) for d in ys], axis=0)
-        row[f"w{w}"] = {"per_blank": per, "mean_of_losses": float(np.mean(per)),
-                        "loss_of_mean": 0.5 * float(np.sum((Rs[w] @ np.where(valid, ym - meas, 0.0)) ** 2))}
+        row[f"w{w}"] = {"per_blank": per, "mean_of_losses": float(np.mean(per)) if ok else None,
+                        "loss_of_mean": 0.5 * float(np.sum((Rs[w] @ np.where(valid, ym - meas, 0.0)) ** 2)) if ok else None}
     out["points"][k] = row
-    print(k, ok, {w: [round(v) for v in row[f"w{w}"]["per_blank"]] + [round(row[f"w{w}"]["loss_of_mean"])] for w in W},
-          flush=True)
+    print(k, ok, {w: row[f"w{w}"] for w in W} if not ok else
+          {w: [round(v) for v in row[f"w{w}"]["per_blank"]] + [round(row[f"w{w}"]["loss_of_mean"])] for w in W}, flush=True)
 out["forming_runs"] = runs.runs
 out["wall_s"] = time.perf_counter() - t0
 json.dump(out, open(sys.argv[1], "w"), indent=1)
+if not all(r["ok"] for r in out["points"].values()):
+    sys.exit(f"{sys.argv[0]}: a forming run failed (ok false in {sys.argv[1]})")

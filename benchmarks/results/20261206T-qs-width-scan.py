@@ -41,3 +41,5 @@ out["chi2_mean_at_truth"] = {w: sec_mod.chi_square_moments(sec_mod.weights(secti
                              for w in out["widths_mm"]}
 out["wall_s"] = time.perf_counter() - t0
 json.dump(out, open(sys.argv[1], "w"), indent=1)
+if not all(r["ok"] for r in out["points"].values()):
+    sys.exit(f"{sys.argv[0]}: a forming run failed (ok false in {sys.argv[1]})")

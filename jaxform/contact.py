@@ -136,8 +136,8 @@ def penetration(g, width):
     return delta, energy
 
 
-def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
-    """Contact force on one node against a rigid surface.
+def node_contact(phi, normal, v_rel, offset, area, params: ContactParams, *, friction: bool = True):
+    """Contact force on a node against a rigid surface: one node, or many in structure of arrays.
 
     Args:
         phi: () signed distance of the node to the tool, m.
@@ -146,6 +146,11 @@ def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
         offset: () distance from the node (mid-surface) to the contacting face, m (``h / 2``).
         area: () tributary area of the node, m².
         params: :class:`ContactParams`.
+        friction: static; ``False``: the normal force alone (the friction integrated backward
+            elsewhere), its power 0.
+
+    Many nodes: ``phi``, ``offset``, ``area`` (N,) and ``normal``, ``v_rel`` (3, N) (the vectors'
+    components along the first axis), the results likewise.
 
     Returns:
         ``(force (3,) N, pressure () Pa, gap () m, energy () J, friction_power () W)``.
@@ -153,19 +158,22 @@ def node_contact(phi, normal, v_rel, offset, area, params: ContactParams):
     g = phi - offset
     delta, e = penetration(g, params.smooth_width)
     in_contact = delta > 0
-    v_n = jnp.dot(v_rel, normal)
+    v_n = jnp.sum(v_rel * normal, axis=0)
     p_elastic = params.stiffness * delta
     p_damp = jnp.where(in_contact, -params.damping * v_n, 0.0)
     pressure = jnp.maximum(p_elastic + p_damp, 0.0)
     f_n = pressure * area
+    energy = area * params.stiffness * e
+    if not friction:
+        return f_n * normal, pressure, g, energy, jnp.zeros_like(g)
     v_t = v_rel - v_n * normal
     eps_v = jnp.maximum(params.slip_velocity, params.friction * pressure * params.stick_limit)
     f_t = regularised_friction(v_t, f_n, params.friction, eps_v)
-    force = f_n * normal + f_t
-    return force, pressure, g, area * params.stiffness * e, -jnp.dot(f_t, v_t)
+    return f_n * normal + f_t, pressure, g, energy, -jnp.sum(f_t * v_t, axis=0)
 
 
-def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_velocity, active=None) -> ContactResult:
+def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_velocity, active=None,
+                 friction: bool = True) -> ContactResult:
     """Contact of all fabric nodes with one rigid tool.
 
     Args:
@@ -179,21 +187,23 @@ def tool_contact(tool, x, v, offset, area, params: ContactParams, *, dz, tool_ve
         tool_velocity: (3,) tool velocity, m/s.
         active: optional (N,) 0/1 weights: which nodes may touch this tool (e.g. only the ply
             next to it in a stack).
+        friction: static; ``False``: the normal force alone (:func:`node_contact`).
 
     Returns:
         :class:`ContactResult`.
     """
-    x = jnp.asarray(x)
-    n = x.shape[0]
-    phi, normal = tools.sdf(tool, x, dz)
-    offset = jnp.broadcast_to(jnp.asarray(offset, x.dtype), (n,))
-    area = jnp.broadcast_to(jnp.asarray(area, x.dtype), (n,))
-    v_rel = jnp.asarray(v) - jnp.asarray(tool_velocity, x.dtype)
-    f, p, g, e, pw = jax.vmap(node_contact, in_axes=(0, 0, 0, 0, 0, None))(phi, normal, v_rel, offset, area, params)
+    xs = jnp.asarray(x).T  # structure of arrays (3, N): the law runs on contiguous rows
+    n = xs.shape[1]
+    phi, normal = tools.sdf_soa(tool, xs, dz)
+    offset = jnp.broadcast_to(jnp.asarray(offset, xs.dtype), (n,))
+    area = jnp.broadcast_to(jnp.asarray(area, xs.dtype), (n,))
     if active is not None:
-        a = jnp.asarray(active, x.dtype)
-        f, p, e, pw = f * a[:, None], p * a, e * a, pw * a
-    return ContactResult(force=f, reaction=-jnp.sum(f, axis=0), pressure=p, gap=g, energy=jnp.sum(e),
+        area = area * jnp.asarray(active, xs.dtype)
+    v_rel = jnp.asarray(v, xs.dtype).T - jnp.asarray(tool_velocity, xs.dtype)[:, None]
+    f, p, g, e, pw = node_contact(phi, normal, v_rel, offset, area, params, friction=friction)
+    if active is not None:  # (the area already zeroes force, energy and power; the pressure too)
+        p = p * jnp.asarray(active, xs.dtype)
+    return ContactResult(force=f.T, reaction=-jnp.sum(f, axis=1), pressure=p, gap=g, energy=jnp.sum(e),
                          friction_power=jnp.sum(pw))
 
 
@@ -306,8 +316,9 @@ def pair_forces(x, slave, master_nodes, w, f):
 
 
 def force_params(load) -> ContactParams:
-    """The parameters a contact load's ``force`` evaluates (tools, plies, self-contact): without
-    friction where the integrator adds it backward (``load.implicit_friction``)."""
+    """The parameters a fabric contact load's ``force`` evaluates (plies, self-contact): without
+    friction where the integrator adds it backward (``load.implicit_friction``; a
+    :class:`ToolLoad` leaves the friction out of :func:`tool_contact` instead)."""
     return dataclasses.replace(load.params, friction=0.0) if load.implicit_friction else load.params
 
 
@@ -383,8 +394,8 @@ class ToolLoad:
                       "friction_power": jnp.zeros((), x.dtype), "max_pressure": jnp.max(self.params.stiffness * delta * act),
                       "backward_support": (g, normal, area, vel)}
             return jnp.zeros_like(x), load_state, extras
-        res = tool_contact(self.tool, x, v, self.offset, self.area, force_params(self), dz=dz, tool_velocity=vel,
-                           active=self.active)
+        res = tool_contact(self.tool, x, v, self.offset, self.area, self.params, dz=dz, tool_velocity=vel,
+                           active=self.active, friction=not self.implicit_friction)
         new = load_state
         if self.force_controlled:
             new = holder_step(load_state, res.reaction[2], mass=self.mass, force=self.clamp_force, dt=self.dt,
@@ -426,8 +437,9 @@ class PlyLoad:
 
     ``load_state`` is a :class:`jaxform.broadphase.SearchState` (its ``candidates`` first): the
     ``k`` candidates per slave node come from the cell grid of :func:`jaxform.broadphase.candidates`
-    within ``gap0 + skin``, rebuilt inside ``lax.cond`` when a node has moved by half the skin
-    since the last refresh (or after ``refresh_every`` calls).
+    within ``gap0 + skin``, rebuilt inside ``lax.cond`` when the nodes may have moved against each
+    other by the skin since the last refresh (:func:`jaxform.broadphase.refreshed`; also after
+    ``refresh_every`` calls where that is > 0).
 
     Attributes:
         slave: (N_s,) int; triangles: (F, 3) int; gap0: () m; area: () or (N_s,) m²;
@@ -448,7 +460,7 @@ class PlyLoad:
     params: Any
     skin: Any = None
     k: int = static_field(default=8)
-    refresh_every: int = static_field(default=200)
+    refresh_every: int = static_field(default=0)
     cap: int = static_field(default=8)
     implicit_friction: bool = static_field(default=True)
     implicit_normal: bool = static_field(default=False)

@@ -30,8 +30,9 @@ def regularised_friction(v_t, normal_force, mu, eps_v):
     """Regularised Coulomb force (3,), N, for slip velocity ``v_t`` (3,) m/s and ``F_n`` >= 0 (N).
 
     ``-mu F_n v_t / sqrt(|v_t|^2 + eps_v^2)``: magnitude below ``mu F_n``, smooth at zero slip.
+    Many nodes in structure of arrays: ``v_t`` (3, N), ``F_n`` and ``eps_v`` (N,) or (), force (3, N).
     """
-    return -mu * normal_force * v_t / jnp.sqrt(jnp.sum(v_t * v_t) + eps_v * eps_v)
+    return -mu * normal_force * v_t / jnp.sqrt(jnp.sum(v_t * v_t, axis=0) + eps_v * eps_v)
 
 
 FRICTION_ITERATIONS = 12  # Newton steps of backward_friction: within 1e-6 of mu F_n where a / eps_v <= 1e5
@@ -42,10 +43,11 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
 
     With ``u*`` the tangential slip speed the trial momentum implies (``(p - m w)_t / m``) and
     ``a = h mu F_n / m`` (the speed friction can remove in the step), the end-of-step slip speed
-    ``u`` solves ``u + a u / sqrt(u**2 + eps_v**2) = u*`` (:data:`FRICTION_ITERATIONS` Newton steps
-    from ``max(u* - a, 0)``, converging from below: the force never exceeds ``mu F_n`` and never
-    reverses the slip). The force is the law at ``u``: ``-mu F_n u / sqrt(u**2 + eps_v**2)``
-    along the trial slip. ``eps_v -> 0`` is Coulomb's return mapping ``u = max(u* - a, 0)``.
+    ``u`` solves ``u + a u / sqrt(u**2 + eps_v**2) = u*`` (Newton from ``max(u* - a, 0)``, at most
+    :data:`FRICTION_ITERATIONS` steps, fewer once a step changes no node; converging from below:
+    the force never exceeds ``mu F_n`` and never reverses the slip). The force is the law at ``u``:
+    ``-mu F_n u / sqrt(u**2 + eps_v**2)`` along the trial slip. ``eps_v -> 0`` is Coulomb's return
+    mapping ``u = max(u* - a, 0)``.
 
     Args:
         p: (N, 3) trial momentum of each node at the end of the step (every other force applied),
@@ -60,12 +62,14 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
         ``(force (N, 3) N, power (N,) W)``: the friction force and the power it dissipates at
         the end-of-step slip (>= 0).
     """
-    fn = safe_norm(f_normal)
-    n = safe_normalize(f_normal)
+    # structure of arrays (3, N) inside: the per-node arithmetic runs on contiguous rows
+    ps, fs = jnp.asarray(p).T, jnp.asarray(f_normal, p.dtype).T
+    fn = safe_norm(fs, axis=0)
+    n = safe_normalize(fs, axis=0)
     m = jnp.asarray(mass, p.dtype)
-    q = p - m[:, None] * jnp.asarray(velocity, p.dtype)
-    qt = q - jnp.sum(q * n, axis=-1, keepdims=True) * n
-    u_star = safe_norm(qt) / m
+    q = ps - m * jnp.asarray(velocity, p.dtype)[:, None]
+    qt = q - jnp.sum(q * n, axis=0) * n
+    u_star = safe_norm(qt, axis=0) / m
     a = h * mu * fn / m
     eps = jnp.asarray(eps_v, p.dtype)
 
@@ -73,19 +77,24 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
         return u + a * u / jnp.sqrt(u * u + eps * eps) - u_star
 
     def solve(g, u0):
-        def newton(_, u):
+        def newton(c):
+            i, u, _ = c
             r = jnp.sqrt(u * u + eps * eps)
-            return jnp.clip(u - g(u) / (1.0 + a * eps * eps / (r * r * r)), 0.0, u_star)
+            un = jnp.clip(u - g(u) / (1.0 + a * eps * eps / (r * r * r)), 0.0, u_star)
+            return i + 1, un, jnp.any(un != u)
 
-        return jax.lax.fori_loop(0, FRICTION_ITERATIONS, newton, u0)
+        # stops early once a step changes no node's u (a fixed point of the rounded iteration: the
+        # steps after it would change nothing either), else after FRICTION_ITERATIONS steps
+        go = lambda c: (c[0] < FRICTION_ITERATIONS) & c[2]  # noqa: E731
+        return jax.lax.while_loop(go, newton, (0, u0, jnp.asarray(True)))[1]
 
     # derivatives by the implicit function theorem at the root (one scalar equation per node: the
     # tangent solve divides by dg/du), not through the Newton loop: a lighter reverse program
     u = jax.lax.custom_root(residual, jnp.maximum(u_star - a, 0.0), solve,
                             lambda g, y: y / g(jnp.ones_like(y)))
     mag = mu * fn * u / jnp.sqrt(u * u + eps * eps)
-    force = -mag[:, None] * safe_normalize(qt, fallback=jnp.zeros(3, p.dtype))
-    return force, mag * u
+    force = -mag * safe_normalize(qt, fallback=jnp.zeros(3, p.dtype), axis=0)
+    return force.T, mag * u
 
 
 def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps_v, share=1.0):

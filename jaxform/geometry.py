@@ -54,21 +54,26 @@ def safe_norm(v, axis=-1, keepdims=False):
     return safe_sqrt(jnp.sum(v * v, axis=axis, keepdims=keepdims))
 
 
-def safe_normalize(v, fallback=EZ, tiny=1e-30):
+def safe_normalize(v, fallback=EZ, tiny=1e-30, axis=-1):
     """Unit vector along ``v``; ``fallback`` where ``|v|**2 <= tiny``.
 
     Args:
-        v: (..., 3) vectors, unit u.
+        v: (..., 3) vectors, unit u (components along ``axis``: 0 for structure of arrays (3, N)).
         fallback: (3,) or an array broadcastable to ``v``: the direction used for (nearly) zero
             vectors (default ``+z``).
         tiny: squared length, u², at or below which ``v`` counts as zero.
     Returns:
         (..., 3) unit vectors (dimensionless), finite everywhere with finite gradients.
     """
-    s = jnp.sum(v * v, axis=-1, keepdims=True)
+    s = jnp.sum(v * v, axis=axis, keepdims=True)
     ok = s > tiny
     unit = v / jnp.sqrt(jnp.where(ok, s, 1.0))
-    return jnp.where(ok, unit, jnp.asarray(fallback, dtype=unit.dtype))
+    fallback = jnp.asarray(fallback, dtype=unit.dtype)
+    if fallback.ndim == 1 and v.ndim > 1:  # a (3,) direction along the components' axis
+        shape = [1] * v.ndim
+        shape[axis] = fallback.shape[0]
+        fallback = fallback.reshape(shape)
+    return jnp.where(ok, unit, fallback)
 
 
 def safe_div(x, y, default=0.0):

@@ -31,9 +31,9 @@ The node-to-face friction is integrated backward, as between the plies of a stac
 (:meth:`SelfContactLoad.friction`: no stick limit), each of a fold's two passes solving half of
 each pair.
 
-Candidates come from the cell grid of :mod:`jaxform.broadphase`, refreshed when a node has moved
-by half the skin. Differentiable where it is smooth, like the tool contact; the side and the
-candidate table are integers of the state (no gradient).
+Candidates come from the cell grid of :mod:`jaxform.broadphase`, refreshed when the nodes may
+have moved against each other by the skin. Differentiable where it is smooth, like the tool
+contact; the side and the candidate table are integers of the state (no gradient).
 """
 from __future__ import annotations
 
@@ -229,7 +229,7 @@ class SelfContactLoad:
     edge_k: int = static_field(default=4)
     active_cap: int = static_field(default=1024)
     edge_active_cap: int = static_field(default=3072)
-    refresh_every: int = static_field(default=200)
+    refresh_every: int = static_field(default=0)
     cap: int = static_field(default=8)
     implicit_friction: bool = static_field(default=True)
     implicit_normal: bool = static_field(default=False)
@@ -385,7 +385,7 @@ class SelfContactLoad:
 
 
 def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=None, exclusion=None,
-                      skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 200, cap: int = 8,
+                      skin=None, k: int = 8, edge_k: int = 4, refresh_every: int = 0, cap: int = 8,
                       active_fraction: float = 0.125, implicit_friction: bool = True, implicit_normal: bool = False,
                       dtype=jnp.float32):
     """Build a :class:`SelfContactLoad` on the host from the reference mesh.
@@ -396,7 +396,8 @@ def self_contact_load(x0, tris, node_area, group, thickness, params, *, pair_ok=
         thickness: ply thickness h, m (the contact distance); params: ContactParams (fabric–fabric).
         pair_ok: (G, G) bool plies allowed to touch (default all; index by ``group``).
         exclusion: own-neighbourhood distance, m (default ``2 h``).
-        skin: search margin beyond ``h``, m (default ``h``): refresh when a node moved ``skin / 2``.
+        skin: search margin beyond ``h``, m (default ``h``): refresh when the nodes may have moved
+            against each other by ``skin`` (:func:`jaxform.broadphase.refreshed`).
         k, edge_k, refresh_every, cap: see :class:`SelfContactLoad`.
         active_fraction: room for the nodes and edges near a candidate at a refresh (evaluated each
             step; when more are near, all are evaluated).

@@ -411,9 +411,17 @@ def sdf(tool, points, dz=0.0):
         ``(phi, normal)``: (N,) signed distance, m, positive outside the material; (N, 3) outward
         unit normal (finite everywhere; ``+z`` at degenerate points).
     """
+    phi, normal = sdf_soa(tool, jnp.asarray(points).T, dz)
+    return phi, normal.T
+
+
+def sdf_soa(tool, points, dz=0.0):
+    """:func:`sdf` of points in structure of arrays: ``points`` (3, N) m -> ``(phi (N,) m, normal
+    (3, N))``. The contact kernels' layout: each point's coordinates are rows, so the per-point
+    shape functions run on contiguous (N,) vectors (a trailing axis of 3 does not vectorise on CPU)."""
     points = jnp.asarray(points)
     shift = jnp.zeros(3, points.dtype).at[2].set(jnp.asarray(dz, points.dtype))
-    return jax.vmap(lambda p: _phi_normal_one(tool, p - shift))(points)
+    return jax.vmap(lambda p: _phi_normal_one(tool, p - shift), in_axes=1, out_axes=(0, 1))(points)
 
 
 def union_sdf(tools, points, dz=0.0):
@@ -499,6 +507,7 @@ __all__ = [
     "GridSDF",
     "FormingTools",
     "sdf",
+    "sdf_soa",
     "union_sdf",
     "hemisphere_rig",
     "displacement",

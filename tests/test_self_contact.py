@@ -65,6 +65,31 @@ def test_grid_reads_a_crowded_cell_in_full():
     np.testing.assert_array_equal(np.asarray(ids)[0], np.argsort(d2)[:8])
 
 
+def test_refresh_criterion_bounds_every_pair_and_ignores_a_shared_motion():
+    """:func:`broadphase.moved_beyond` with ``s``: while it says no, no two points (hence no node
+    and point of a triangle, a convex combination) have closed or parted by more than ``2 s``;
+    a translation of everything (a sagging blank) is no motion, the same motion with one point
+    staying behind is."""
+    rng = np.random.default_rng(3)
+    x0 = rng.uniform(0.0, 0.1, (300, 3))
+    pair = lambda x: np.linalg.norm(x[:, None] - x[None], axis=-1)  # noqa: E731
+    moved = jax.jit(broadphase.moved_beyond)
+    s = 1e-3
+    checked = 0
+    for _ in range(200):
+        d = rng.normal(0.0, 1.0, (1, 3)) * 5e-3 + rng.normal(0.0, rng.uniform(1e-4, 1e-3), (300, 3))
+        x = x0 + d
+        if not bool(moved(x, x0, s)):
+            checked += 1
+            assert np.max(np.abs(pair(x) - pair(x0))) <= 2 * s * (1 + 1e-9)
+    assert checked > 20
+    shift = np.array([0.02, -0.01, -0.05])  # 54 mm, 50 times s
+    assert not bool(moved(x0 + shift, x0, s))
+    behind = np.tile(shift, (300, 1))
+    behind[7] = 0.0
+    assert bool(moved(x0 + behind, x0, s))
+
+
 def _fold(gap, ns=41, ny=7):
     """A strip folded over itself (layers ``gap`` apart) and its flat reference."""
     nodes, t, layer = folded_strip(gap, length=0.02, width=0.006, ns=ns, ny=ny, quads=False)

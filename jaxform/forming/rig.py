@@ -344,8 +344,9 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
 
 def _skin(case: Case) -> float:
     """Search margin of the fabric contacts beyond the contact distance, m: the larger of the ply
-    thickness and a quarter element. Candidates are rebuilt when a node has moved by half of it,
-    so the refresh follows the largest node speed (:func:`jaxform.broadphase.refreshed`)."""
+    thickness and a quarter element. Candidates are rebuilt when the nodes may have moved against
+    each other by it, so the refresh follows the largest relative node speed
+    (:func:`jaxform.broadphase.refreshed`)."""
     return max(float(case.ply_thickness), 0.25 * float(case.element_size))
 
 

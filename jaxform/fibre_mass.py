@@ -68,7 +68,8 @@ import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
-from jaxform.shell import Shell, _corner_ids, _dot, _edges, _fibres_soa, _stretch, membrane_frequency
+from jaxform.mesh import assemble_corners
+from jaxform.shell import Shell, _dot, _edges, _fibres_soa, _stretch, membrane_frequency
 
 BOUND_MARGIN = 1e-3  # spectral_bound's eigenvalue raised by this fraction (Lanczos at tol 1e-4 read the 1 mm woven
 #                      blank's 2.7e-6 below its value at tol 1e-10, which the dense solver agrees with on small meshes)
@@ -241,7 +242,7 @@ def stiffness_times(ps, units, fm: FibreMass, shell: Shell):
     q1, q2 = s[0] * units[0], s[1] * units[1]
     c1 = q1 * coef[:, 0, 0] + q2 * coef[:, 1, 0]
     c2 = q1 * coef[:, 0, 1] + q2 * coef[:, 1, 1]
-    return jnp.zeros_like(ps).at[:, _corner_ids(shell.mesh)].add(jnp.concatenate([-(c1 + c2), c1, c2], axis=1))
+    return assemble_corners(jnp.concatenate([-(c1 + c2), c1, c2], axis=1), shell.mesh)
 
 
 def inverse_mass_times(fs, units, mass, free, fm: FibreMass, shell: Shell):

@@ -20,6 +20,8 @@ geometry that does not depend on the material is precomputed here:
 * ``frame`` (N, 3, 3) and ``tri_frame`` (T, 3, 3): local reference frames. ``t1`` is the global x
   axis projected on the tangent plane (the y axis where x is normal to the surface); ``n`` points
   to the ply's top face (``+z`` for a flat blank meshed counter-clockwise seen from above).
+* ``corner_k`` (C, N): each node's triangle corners, so that per-corner values (the fibre mass's
+  products) are assembled onto the nodes by gathers (:func:`assemble_corners`), not a scatter.
 
 Several plies are stacked by concatenating their nodes and triangles; ``ply_nodes`` and
 ``ply_tris`` (static) give each ply's contiguous ranges, so kernels loop over plies (a handful)
@@ -30,6 +32,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
+import jax.numpy as jnp
 import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
@@ -48,6 +51,8 @@ class Mesh:
             1/m²), neighbour-major (see :attr:`nbr` and :attr:`gfd` for node-major views).
         frame: (N, 3, 3) local reference frame per node, rows (t1, t2, n).
         tri_frame: (T, 3, 3) local reference frame per triangle, rows (t1, t2, n).
+        corner_k: (C, N) int32 the triangle corners of each node (:func:`corner_table`), for
+            assembling per-corner values by gathers.
         ply_nodes: static tuple of (start, stop) node ranges, one per ply.
         ply_tris: static tuple of (start, stop) triangle ranges, one per ply.
         quads: static flag: True when ``tris`` come from a quad grid in pairs (2q, 2q+1).
@@ -61,6 +66,7 @@ class Mesh:
     gfd_k: Any
     frame: Any
     tri_frame: Any
+    corner_k: Any
     ply_nodes: tuple = static_field(default=((0, 0),))
     ply_tris: tuple = static_field(default=((0, 0),))
     quads: bool = static_field(default=False)
@@ -182,12 +188,42 @@ class Mesh:
         return _build(parts, quads=True, shape=(nx, ny))
 
     def replace(self, **changes) -> "Mesh":
+        """The mesh with ``changes``; new triangles get their corner table (host side)."""
         import dataclasses
 
+        if "tris" in changes and "corner_k" not in changes:
+            nodes = changes.get("nodes", self.nodes)
+            changes["corner_k"] = corner_table(np.asarray(changes["tris"]), int(np.shape(nodes)[0]))
         return dataclasses.replace(self, **changes)
 
 
 # ------------------------------------------------------------------------------------------- host side
+
+
+def corner_table(tris, n_nodes: int) -> np.ndarray:
+    """(C, N) int32: for each node, where its triangle corners lie in the corner-major layout of
+    per-corner values (``concatenate([v0, v1, v2], axis=-1)``, 3T long), ``C`` the most triangles
+    on a node; padded with ``3 T`` (a zero appended to the values). Summing the gathered values
+    over ``C`` assembles them onto the nodes, as a scatter-add by corner would, without one (a
+    gather is the cheaper of the two on CPU)."""
+    tris = np.asarray(tris)
+    ids = np.concatenate([tris[:, 0], tris[:, 1], tris[:, 2]])
+    order = np.argsort(ids, kind="stable")
+    counts = np.bincount(ids, minlength=n_nodes)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    table = np.full((max(1, int(counts.max())), n_nodes), 3 * len(tris), np.int32)
+    for j in range(table.shape[0]):
+        has = counts > j
+        table[j, has] = order[start[has] + j]
+    return table
+
+
+def assemble_corners(vals, mesh: Mesh):
+    """(3, N): per-corner values ``vals`` (3, 3T), corner-major (:func:`corner_table`), summed onto
+    their nodes by gathers; the same as ``zeros.at[:, corners].add(vals)``."""
+    v = jnp.concatenate([vals, jnp.zeros((vals.shape[0], 1), vals.dtype)], axis=1)
+    table = mesh.corner_k
+    return sum(v[:, table[j]] for j in range(table.shape[0]))
 
 
 def _unit(v):
@@ -372,6 +408,7 @@ def _build(parts, *, quads: bool, shape) -> Mesh:
         gfd_k=np.ascontiguousarray(np.concatenate(all_w).transpose(2, 1, 0)),
         frame=np.concatenate(all_frames),
         tri_frame=np.concatenate(all_tframes),
+        corner_k=corner_table(np.concatenate(all_tris), n_off),
         ply_nodes=tuple(ply_nodes),
         ply_tris=tuple(ply_tris),
         quads=quads,
@@ -379,4 +416,4 @@ def _build(parts, *, quads: bool, shape) -> Mesh:
     )
 
 
-__all__ = ["Mesh"]
+__all__ = ["Mesh", "corner_table", "assemble_corners"]

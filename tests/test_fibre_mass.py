@@ -53,6 +53,23 @@ def _largest_eigenvalue(apply, shape, iters=400):
     return lam
 
 
+def test_corners_assembled_by_gathers_equal_the_scatter_add():
+    """The fibre mass's products sum per-corner values onto the nodes by gathers
+    (:func:`jaxform.mesh.assemble_corners`): the same sums as a scatter-add, on a two-ply mesh and
+    on one whose triangles were replaced (the rig's mirror-symmetric blank)."""
+    from jaxform.forming import rig
+    from jaxform.mesh import assemble_corners
+
+    two = Mesh.rectangle(0.04, 0.03, 0.005, plies=2, ply_spacing=1e-3)
+    blank = rig.build_mesh(cases.with_element_size(cases.load("case-a-woven-nlbm"), 0.025))
+    for mesh in (two, blank):
+        t = np.asarray(mesh.tris)
+        vals = jnp.asarray(np.random.default_rng(2).normal(size=(3, 3 * len(t))))
+        ids = np.concatenate([t[:, 0], t[:, 1], t[:, 2]])
+        want = jnp.zeros((3, mesh.n_nodes), vals.dtype).at[:, ids].add(vals)
+        np.testing.assert_allclose(jax.jit(assemble_corners)(vals, mesh), want, rtol=1e-12, atol=1e-12)
+
+
 def test_spectral_bound_holds_for_any_fibre_directions_and_is_not_loose():
     """``X`` bounds ``M^-1 K_t`` whatever the current fibre directions (power iteration): at the
     reference, sheared 50 degrees, and with random directions per triangle."""

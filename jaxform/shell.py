@@ -44,7 +44,7 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.geometry import safe_sqrt, tiny_sqrt
-from jaxform.mesh import Mesh
+from jaxform.mesh import Mesh, assemble_corners
 
 SHEAR_READINGS = ("a14", "conjugate")
 
@@ -144,13 +144,6 @@ def _stretch(g):
 
 # Kernels work on structure-of-arrays vectors (3, n): long contiguous rows vectorise and fuse on
 # CPU, where (n, 3) layouts with tiny trailing axes do not (measured: 5-10x).
-
-
-def _corner_ids(mesh: Mesh):
-    """(3T,) node of every triangle corner, corner-major: the scatter indices of per-corner values
-    laid out as ``concatenate([c0, c1, c2], axis=1)``."""
-    t = mesh.tris
-    return jnp.concatenate([t[:, 0], t[:, 1], t[:, 2]])
 
 
 def _edges(xs, mesh: Mesh, base=None):
@@ -380,8 +373,8 @@ def forces_and_energy(x, shell: Shell):
 
     Each element's (node's) energy depends only on its own edge vectors (derivative stencil), so
     the local gradients are taken element-wise (``grad`` of a sum of independent terms, no
-    scatter) and assembled once: triangle corners by scatter-add, the bending stencil by the
-    transpose of its gather. The result equals ``-jax.grad(energy)`` (tested).
+    scatter) and assembled once: triangle corners by gathers (:func:`~jaxform.mesh.assemble_corners`),
+    the bending stencil by the transpose of its gather. The result equals ``-jax.grad(energy)`` (tested).
     """
     f, parts = forces_and_energy_soa(x.T, shell)
     return f.T, parts
@@ -401,15 +394,10 @@ def forces_and_energy_soa(xs, shell: Shell, weights=None, displacement: bool = F
     argnums = (0, 1, 2) if has_b else (0, 1)
     (_, parts), grads = jax.value_and_grad(_local_energy, argnums=argnums, has_aux=True)(e1, e2, D, shell, weights)
     g1, g2 = grads[0], grads[1]
-    ids = _corner_ids(mesh)
-    vals = jnp.concatenate([-(g1 + g2), g1, g2], axis=1)  # dE/dx of the corners (3, 3T)
+    grad_s = assemble_corners(jnp.concatenate([-(g1 + g2), g1, g2], axis=1), mesh)  # dE/dx of the corners
     if has_b:
         H = _derivs_transpose(grads[2], mesh)  # (3, K, N) dE/d(x_nbr_k - x_i)
-        ids = jnp.concatenate([ids, mesh.nbr_k.reshape(-1)])
-        vals = jnp.concatenate([vals, H.reshape(3, -1)], axis=1)
-        grad_s = jnp.zeros_like(xs).at[:, ids].add(vals) - jnp.sum(H, axis=1)
-    else:
-        grad_s = jnp.zeros_like(xs).at[:, ids].add(vals)
+        grad_s = grad_s + jnp.zeros_like(xs).at[:, mesh.nbr_k.reshape(-1)].add(H.reshape(3, -1)) - jnp.sum(H, axis=1)
     return -grad_s, parts
 
 

@@ -20,8 +20,8 @@ geometry that does not depend on the material is precomputed here:
 * ``frame`` (N, 3, 3) and ``tri_frame`` (T, 3, 3): local reference frames. ``t1`` is the global x
   axis projected on the tangent plane (the y axis where x is normal to the surface); ``n`` points
   to the ply's top face (``+z`` for a flat blank meshed counter-clockwise seen from above).
-* ``corner_k`` (C, N): each node's triangle corners, so that per-corner values (the fibre mass's
-  products) are assembled onto the nodes by gathers (:func:`assemble_corners`), not a scatter.
+* ``corner_k`` (C, N): each node's triangle corners, so that per-corner values (the shell's
+  triangle forces, the fibre mass's products) are assembled onto the nodes by gathers (:func:`assemble_corners`), not a scatter.
 
 Several plies are stacked by concatenating their nodes and triangles; ``ply_nodes`` and
 ``ply_tris`` (static) give each ply's contiguous ranges, so kernels loop over plies (a handful)

@@ -1,5 +1,5 @@
 """ms a step over W steps (default 2000) from saved states of the shipped 2 mm woven run (profile_run.py), with
-the jaxform first on sys.path. Run: python ab_windows.py start,41450,82900,124350 2000 STATE_DIR"""
+the jaxform first on sys.path; exit 1 if a window went bad. Run: python ab_windows.py start,41450,82900,124350 2000 STATE_DIR"""
 from pathlib import Path
 import sys, time, pickle, json, jax, jax.numpy as jnp
 import jaxform
@@ -19,3 +19,4 @@ for name in sys.argv[1].split(","):
     row = {"state": name, "step": int(st.step), "ms_per_step": 1e3 * dt / W, "refreshes": int(e.loads[3].refreshes) - int(st.loads[3].refreshes), "bad": int(e.bad_step)}
     out["rows"].append(row); print(row, flush=True)
 print(json.dumps(out))
+sys.exit("ab_windows.py: a window left its bounds (bad step)" if any(r["bad"] >= 0 for r in out["rows"]) else 0)

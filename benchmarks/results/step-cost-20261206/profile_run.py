@@ -1,5 +1,6 @@
 """The shipped 2 mm woven run stepped in windows: ms a step, self-contact refreshes, its active
-set and overflow, along the whole stroke; states saved at a quarter, half and three quarters. Run: python profile_run.py OUT_DIR"""
+set and overflow, along the whole stroke; states saved at a quarter, half and three quarters. Exit 1 if
+the run left its bounds. Run: python profile_run.py OUT_DIR"""
 from pathlib import Path
 import sys, time, json, pickle, numpy as np, jax, jax.numpy as jnp
 from jaxform import cases, integrate
@@ -36,3 +37,4 @@ while int(s.step) < n:
             save_at.discard(a)
 out.write(json.dumps({"total_s": time.perf_counter() - t_all, "steps": int(s.step)}) + "\n")
 pickle.dump(jax.tree_util.tree_map(np.asarray, s), open(OUT / "state_end.pkl", "wb"))
+sys.exit(f"profile_run.py: the run left its bounds at step {int(s.bad_step)}" if int(s.bad_step) >= 0 else 0)

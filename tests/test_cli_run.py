@@ -258,6 +258,30 @@ def test_a_run_that_leaves_its_physical_bounds_stops_and_says_why(tmp_out):
     assert len(_pvd_files(tmp_out)) == 1
 
 
+def test_a_blank_drawn_into_the_die_stops_the_run_as_a_failed_forming(tmp_out, capsys):
+    """A 120 mm blank (its edge 1 mm outside the die's fillet) under a 50 mm stroke: the hemisphere
+    needs more fabric than the flange has, the edge goes over the fillet into the die near 27 mm of
+    punch travel. The run stops there, calling it an outcome of the case (not a failed simulation),
+    with no remedy tried, and keeps its frames."""
+    from jaxform.forming.health import DRAWN_IN
+
+    args = ["run", "case-a-woven-nlbm", "--out", str(tmp_out), "--element-size-mm", "12", "--set", "blank.size_mm=120",
+            "--set", "process.frames=6", *FAST_SET, "--quiet"]
+    assert main(args) == 1
+    out = capsys.readouterr().out
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] is False and s["reason"].startswith("the forming failed near step ")
+    assert DRAWN_IN in s["reason"] and "simulation failed" not in s["reason"] and "INCOMPLETE (the forming failed" in out
+    assert "membrane only" in s["reason"] and "blank too small" in s["reason"]
+    assert s["numerics"]["step_cuts"] == [] and s["numerics"]["fibre_mass_momentum_term_choice"] == "no fibre mass"
+    assert 0 < s["numerics"]["steps_done"] < s["numerics"]["n_steps"]
+    assert len(_pvd_files(tmp_out)) == s["frames_written"] == len(s["frame_times_s"]) >= 2
+    last = meshio.read(sorted(tmp_out.glob("frames_*.vtu"))[-1])
+    x = last.points
+    edge = np.max(np.abs(x[:, :2] - last.point_data["displacement_m"][:, :2]), axis=1) > 0.06 - 1e-6
+    assert np.min(np.hypot(x[edge, 0], x[edge, 1])) >= 0.053  # the last good frame: the edge still outside
+
+
 def test_a_contact_too_soft_for_the_pressures_stops_the_run_and_says_which_key(tmp_out, capsys):
     """A contact set for 1 Pa (the penalty 1e5 Pa/m: 10 um at 1 Pa) under the punch's tens of Pa: the
     fabric sinks into the punch by more than half the ply, and the run stops saying so."""

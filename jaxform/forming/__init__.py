@@ -4,6 +4,7 @@ Modules, along the data flow (imports point one way):
 
     case      the SI description of a case and its validation (no I/O, no physics)
     presets   the paper's cases and ``--set`` overrides
+    health    the physical bounds a run never crosses, and their words
     rig       Case -> (Model, State, RunInfo): mesh, fabrics, tools, contact, time step, built once
     fields    nodal fields of a state (pure, jit-able)
     summary   draw-in, wrinkle count, symmetry, the JSON summary, the half-speed check (host, numpy)

@@ -56,8 +56,8 @@ from jax.sharding import PartitionSpec as P
 from jaxform import integrate
 from jaxform.batching import BATCH_AXIS
 from jaxform.forming.case import Case, to_dict
-from jaxform.forming.driver import (BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive, may_stiffen_contact,
-                                    out_of_bounds_message, physical_causes)
+from jaxform.forming.driver import BLOWUP_TOL, FormingResult, Recorder, Standing, _floor, drive, may_stiffen_contact
+from jaxform.forming.health import failure_reason, out_of_bounds_message, physical_causes
 from jaxform.forming.fields import SCALARS, state_fields
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, build
@@ -410,8 +410,8 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                     out = physical_causes(hx[i], {key: v[i] for key, v in hfl.items()}, infos[i].bounds,
                                           recs[i].hist["max_penetration_m"][-1] if may_stiffen_contact(infos[i]) else np.inf)
                     if out:
-                        reasons[i] = "simulation failed: " + out_of_bounds_message(
-                            int(hs[0][i]), float(hs[1][i]), float(hfl["punch_displacement"][i]), out)
+                        reasons[i] = failure_reason(out_of_bounds_message(
+                            int(hs[0][i]), float(hs[1][i]), float(hfl["punch_displacement"][i]), out))
                         causes[i] = "; ".join(out)
                         failed.append(int(i))
                 if failed:
@@ -434,7 +434,7 @@ def run_part(rigs: Sequence[Rig], *, devices=None, on_frame: Callable | None = N
                       t_wall=t_wall)
                 reasons[i] = None
             except integrate.SimulationError as err:
-                reasons[i] = f"simulation failed: {err}"
+                reasons[i] = failure_reason(str(err))
             last_good[i] = at.state
             finished.add(i)
     except KeyboardInterrupt as err:

@@ -5,7 +5,7 @@ that writes frames as they come (callbacks for progress and output).
 energy-balance residual above half the largest energy seen, with a floor of :data:`ENERGY_FLOOR`
 so that float32 rounding at the start of a run never counts); the driver reads that record and
 checks after every chunk that the run stays physical (fibre strain, node speeds, the part inside
-the rig: :class:`~jaxform.forming.rig.HealthBounds`). A run that fails either way stops with
+the rig, the blank's edge outside the die: :mod:`jaxform.forming.health`). A run that fails either way stops with
 ``complete = False``, the step, time and cause, and the frames up to the last good one. Before
 that, a failing chunk is run again from its start with what may keep it stable (:func:`run`):
 with a fibre mass but not its momentum term, with the term; where the step was chosen
@@ -26,6 +26,8 @@ from jaxform import integrate
 from jaxform.penalty import rescaled_load
 from jaxform.forming.case import Case
 from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS, SCALARS, fields_jit
+from jaxform.forming.health import (DEEPER, PENETRATED, drawn_in, failure_reason, out_of_bounds_message, penetrated,
+                                    physical_causes)
 from jaxform.forming.numerics import CONTACT_RAMP, CONTACT_STIFFEN
 from jaxform.forming.presets import apply_overrides, with_element_size
 from jaxform.forming.rig import Rig, RunInfo, build
@@ -164,53 +166,6 @@ class Recorder:
             self.on_frame(k, float(s.t), self.x[-1], host)
 
 
-PENETRATED = "a node penetrated a tool or ply by"
-"""How a cause of :func:`physical_causes` about a penetration begins (:func:`penetrated`)."""
-DEEPER = "the pressures exceed those the automatic contact was chosen for"
-"""How a cause about a penetration beyond ``stiffen_penetration`` (not half the ply) ends."""
-
-
-def penetrated(cause: str) -> bool:
-    """Whether a failure's cause (``"; "``-joined) names a penetration (:func:`physical_causes`)."""
-    return PENETRATED in cause
-
-
-def physical_causes(x, fl, bounds, stiffen_above: float = np.inf) -> list[str]:
-    """Host: how a state (positions ``x`` (N, 3) m, its fields ``fl``) left the physical bounds of
-    a run (:class:`~jaxform.forming.rig.HealthBounds`), in words; empty when it did not. A run can
-    blow up without a NaN or an energy-balance jump: nodes flung away by an over-damped contact
-    still balance their energy. A penetration beyond ``bounds.stiffen_penetration`` counts too
-    where it is also deeper than ``stiffen_above`` (m; the penetration at the chunk's start where
-    the contact may be stiffened: a growing one, not one that heals; ``inf``: never)."""
-    b = bounds
-    x = np.asarray(x)
-    strain, speed = float(fl["max_fibre_strain"]), float(fl["max_node_speed"])
-    causes = []
-    if not strain <= b.fibre_strain:
-        causes.append(f"fibre strain {strain:.3g} beyond {b.fibre_strain:g} (the fibres carry < 0.01)")
-    if not speed <= b.speed:
-        causes.append(f"a node moves at {speed:.3g} m/s, beyond {b.speed:.3g} m/s (100 x the punch speed)")
-    pen = float(fl.get("max_penetration", 0.0))
-    if not pen <= b.penetration:
-        causes.append(f"{PENETRATED} {pen * 1e3:.3g} mm, beyond {b.penetration * 1e3:.3g} mm "
-                      "(half the ply): the contact is too soft for this case's pressures (raise "
-                      "contact.expected_pressure_Pa)")
-    elif not pen <= max(b.stiffen_penetration, stiffen_above):
-        causes.append(f"{PENETRATED} {pen * 1e3:.3g} mm, beyond {b.stiffen_penetration * 1e3:.3g} mm and growing: {DEEPER}")
-    lo, hi = x.min(axis=0), x.max(axis=0)
-    if not (np.all(lo >= np.asarray(b.box_lo)) and np.all(hi <= np.asarray(b.box_hi))):
-        far = max(float(np.max(np.asarray(b.box_lo) - lo)), float(np.max(hi - np.asarray(b.box_hi))))
-        causes.append(f"the part left the rig (nodes {far * 1e3:.3g} mm outside the box of twice the blank)")
-    return causes
-
-
-def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
-    """The words of a run that left its physical bounds (:func:`physical_causes`)."""
-    return (f"the run left its physical bounds near step {step} (t = {t:.6e} s, punch {punch_m * 1e3:.2f} "
-            f"mm): {'; '.join(causes)}. Likely cause: an unstable or badly set-up run (time step, contact stiffness or "
-            "damping, mass scaling); the frames up to the last good one are kept.")
-
-
 def _check_health(state, fl, info: RunInfo, last_good, stiffen_above: float = np.inf) -> None:
     """Raise :class:`~jaxform.integrate.SimulationError` when the run left the physical bounds of
     ``info.bounds`` (:func:`physical_causes`, ``stiffen_above`` as there)."""
@@ -347,12 +302,15 @@ class Standing:
 
     def recover(self, rec: "Recorder", cause: str) -> bool:
         """What to change before the chunk that failed with ``cause`` runs again from the last
-        good state; False where nothing is left to change. A penetration (:func:`penetrated`):
+        good state; False where nothing is left to change, or where the blank's edge went into the
+        die (:func:`~jaxform.forming.health.drawn_in`: the forming failed). A penetration (:func:`penetrated`):
         half the step, and the contact on its way to :data:`~jaxform.forming.numerics.CONTACT_STIFFEN`
         times as stiff (:meth:`ramp`; at once beyond half the ply), an automatic contact only: a
         step cut alone never helps there. Else: the momentum
         term (:meth:`switch`), else half the step (down to 1/:data:`MAX_STEP_CUT`, an automatic
         step only)."""
+        if drawn_in(cause):
+            return False
         if penetrated(cause):
             if not self.can_stiffen:
                 return False
@@ -390,7 +348,7 @@ def drive(at: Standing, info: RunInfo, rec: "Recorder", *, e0, x_ref, on_progres
                 break
             except integrate.SimulationError as err:
                 if not at.recover(rec, err.cause):
-                    if at.cut > 1:
+                    if at.cut > 1 and not drawn_in(err.cause):
                         raise integrate.SimulationError(
                             f"{err} It failed also with the step cut to 1/{at.cut}.", step=err.step, time=err.time,
                             cause=err.cause, frames=err.frames, state=err.state) from err
@@ -455,7 +413,7 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     except integrate.SimulationError as err:
         if not catch:
             raise
-        reason = f"simulation failed: {err}"
+        reason = failure_reason(str(err))
     except Exception as err:  # noqa: BLE001 - reported in the summary, re-raised unless catch
         if not catch:
             raise

@@ -39,7 +39,8 @@ import numpy as np
 
 from jaxform import contact, integrate, penalty, units
 from jaxform.forming.case import LBM_VARIANTS, Case, ply_heights
-from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, STIFFEN_PENETRATION, ContactNumerics, auto_fibre_mass,
+from jaxform.forming.health import HealthBounds, health_bounds
+from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNumerics, auto_fibre_mass,
                                       contact_numerics, expected_pressure)
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
@@ -93,44 +94,6 @@ class RunInfo:
     def __repr__(self) -> str:
         return (f"RunInfo(case={self.case.name!r}, nodes={len(self.x0)}, dt={self.dt:.3e} s, "
                 f"n_steps={self.n_steps}, n_frames={self.n_frames})")
-
-
-@dataclasses.dataclass(frozen=True)
-class HealthBounds:
-    """Bounds a physically sound forming run never crosses (derived from the case by :func:`health_bounds`).
-
-    Attributes:
-        fibre_strain: largest ``|fibre strain|`` of any element (the fibres' 3 GPa modulus keeps
-            real strains below 1%); speed: largest node speed, m/s; box_lo, box_hi: (3,) corners
-            of the box the part stays in, m; penetration: deepest penetration of a node into a
-            tool or ply, m; stiffen_penetration: the penetration beyond which an automatic contact
-            is stiffened (:data:`jaxform.forming.numerics.STIFFEN_PENETRATION`), m.
-    """
-
-    fibre_strain: float
-    speed: float
-    box_lo: tuple
-    box_hi: tuple
-    penetration: float = math.inf
-    stiffen_penetration: float = math.inf
-
-
-def health_bounds(case: Case) -> HealthBounds:
-    """The bounds of :class:`HealthBounds` for a case: fibre strain 10% (ten times what the fibres
-    carry), node speed 100 times the punch speed (at least 10 m/s: a snap-through of the flange
-    stays well below), and a box of twice the blank's half-size across, from the punch's lowest
-    reach minus a blank half-size below to the holder's top plus a blank half-size above; a
-    penetration of half the ply thickness (five times what the automatic contact allows at its
-    expected pressure: the pressures exceed it and the contact is too soft), and beyond
-    :data:`~jaxform.forming.numerics.STIFFEN_PENETRATION` of it the automatic contact stiffens."""
-    half = 0.5 * case.blank_size
-    t = case.tools
-    top = (case.holder.gap or case.stack_thickness) + t.holder_thickness + half
-    bottom = -(case.process.stroke + t.die_thickness + half)
-    return HealthBounds(fibre_strain=0.1, speed=max(100.0 * case.process.speed, 10.0),
-                        box_lo=(-2 * half, -2 * half, bottom), box_hi=(2 * half, 2 * half, top),
-                        penetration=0.5 * float(case.ply_thickness),
-                        stiffen_penetration=STIFFEN_PENETRATION * float(case.ply_thickness))
 
 
 class Rig(NamedTuple):
@@ -277,6 +240,14 @@ def _edge_nodes(mesh: Mesh, n0: int):
     mid = [j_mid * nx + nx - 1, j_mid * nx, (ny - 1) * nx + i_mid, i_mid]
     corners = [0, nx - 1, (ny - 1) * nx, ny * nx - 1]
     return np.asarray(mid) + n0, np.asarray(corners) + n0
+
+
+def _blank_edges(mesh: Mesh) -> np.ndarray:
+    """The node indices of every ply's outer edge (the plies are grids of ``mesh.shape``)."""
+    nx, ny = mesh.shape
+    j, i = np.divmod(np.arange(nx * ny), nx)
+    edge = np.flatnonzero((i == 0) | (i == nx - 1) | (j == 0) | (j == ny - 1))
+    return np.concatenate([edge + n0 for n0, _ in mesh.ply_nodes])
 
 
 def _time_step(case: Case, numerics: ContactNumerics, samples_per_frame: int):
@@ -443,7 +414,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     info = RunInfo(case=case, dt=dt, every=every, samples_per_frame=samples_per_frame, n_frames=n_int + 1,
                    n_steps=n_int * every, stroke_time=T, faces=grid_quads(*mesh.shape, plies=case.n_plies),
                    ply_id=_ply_ids(mesh), x0=np.asarray(mesh.nodes), edge_mid=mid, corners=corners,
-                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case), numerics=numerics,
+                   n_ply_loads=case.n_plies - 1, stable_dt=stable, bounds=health_bounds(case, _blank_edges(mesh)), numerics=numerics,
                    fibre_mass_factor=fms)
     return Rig(model, state, info)
 

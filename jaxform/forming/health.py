@@ -69,6 +69,8 @@ PENETRATED = "a node penetrated a tool or ply by"
 """How a cause of :func:`physical_causes` about a penetration begins (:func:`penetrated`)."""
 DEEPER = "the pressures exceed those the automatic contact was chosen for"
 """How a cause about a penetration beyond ``stiffen_penetration`` (not half the ply) ends."""
+FORMING_FAILED = "the forming failed"
+"""How the message of a run stopped by a physical crossing begins (:func:`out_of_bounds_message`)."""
 DRAWN_IN = "the blank's edge was drawn into the die opening"
 """How the cause of a run whose flange is gone begins (:func:`drawn_in`): an outcome of the case, not
 of the numerics, so the driver changes nothing and stops."""
@@ -122,7 +124,7 @@ def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
     """The words of a run that left its physical bounds (:func:`physical_causes`)."""
     where = f"near step {step} (t = {t:.6e} s, punch {punch_m * 1e3:.2f} mm)"
     if any(drawn_in(c) for c in causes):
-        return (f"the forming failed {where}: {'; '.join(causes)}. Nothing held the flange: a ply without the bending "
+        return (f"{FORMING_FAILED} {where}: {'; '.join(causes)}. Nothing held the flange: a ply without the bending "
                 "stiffness to carry the flange's compression (membrane only) under an open holder, or a blank too small "
                 "for the stroke. An outcome of the case, not a numerical failure; the run stops here, the frames up to "
                 "the last good one are kept.")
@@ -132,8 +134,8 @@ def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
 
 def failure_reason(message: str) -> str:
     """A summary's ``reason`` for a run stopped with ``message``: a failed forming is not a failed simulation."""
-    return message if message.startswith("the forming failed") else f"simulation failed: {message}"
+    return message if message.startswith(FORMING_FAILED) else f"simulation failed: {message}"
 
 
-__all__ = ["HealthBounds", "health_bounds", "PENETRATED", "DEEPER", "DRAWN_IN", "penetrated", "drawn_in",
+__all__ = ["HealthBounds", "health_bounds", "PENETRATED", "DEEPER", "FORMING_FAILED", "DRAWN_IN", "penetrated", "drawn_in",
            "physical_causes", "out_of_bounds_message", "failure_reason"]

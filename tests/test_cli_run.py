@@ -321,7 +321,8 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
     import io
 
     from jaxform import cases
-    from jaxform.cli.run import QUASI_STATIC_KE_IE, execute, report
+    from jaxform.cli.run import execute, report
+    from jaxform.forming.summary import QUASI_STATIC_KE_IE
     from jaxform.plots import forming as fplots
 
     case = cases.resolve("case-a-woven-nlbm", element_size=25e-3,
@@ -331,7 +332,34 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
     report(result, written, tmp_out, stream=text)
     ratio = result.summary["max_ke_ie"]
     assert ratio > QUASI_STATIC_KE_IE  # 500 mm/s on a 4 mm stroke: inertia dominates
-    assert "not quasi-static" in text.getvalue() and f"{ratio:.3g}" in text.getvalue()
+    assert "warning: not quasi-static" in text.getvalue() and f"{ratio:.3g}" in text.getvalue()
+    assert [f["kind"] for f in result.summary["findings"] if f["level"] == "warning"] == ["kinetic_energy"]
+    assert json.loads((tmp_out / "summary.json").read_text())["findings"] == result.summary["findings"]
     for fig in (fplots.shear_map(result), fplots.deviation_map(result)):
-        title = fig.axes[0].get_title()
-        assert title.startswith("case-a-woven-nlbm:") and title.endswith("punch 4.0 mm"), title
+        head, doubt = fig.axes[0].get_title().split("\n")
+        assert head.startswith("case-a-woven-nlbm:") and head.endswith("punch 4.0 mm"), head
+        assert doubt == f"NOT quasi-static (KE/IE {ratio:.2g})", doubt
+
+
+def test_findings_say_what_speaks_against_a_result_and_the_report_prints_each():
+    import io
+    from types import SimpleNamespace
+
+    from jaxform.cli.run import report
+    from jaxform.forming.summary import findings
+
+    cut = {"step": 10, "t_s": 0.1, "punch_displacement_m": -0.02, "cause": "energy blow-up", "cut": 2,
+           "contact_stiffness": 1.0}
+    n = {"max_penetration_ply": 0.3, "penetration_limit_ply": 0.1, "expected_pressure_Pa": 1e4,
+         "step_cuts": [cut, {**cut, "step": 20, "cut": 4, "contact_stiffness": 4.0}]}
+    s = {"case": "c", "frames_written": 2, "wall_time_s": 1.0, "max_ke_ie": 0.05, "numerics": n}
+    assert [(f["kind"], f["level"]) for f in findings(s)] == [
+        ("penetration", "warning"), ("step_cut", "note"), ("contact_stiffened", "note")]
+    quiet = {**s, "numerics": {**n, "max_penetration_ply": 0.05, "step_cuts": []}}
+    assert findings(quiet) == [] and findings({**quiet, "max_ke_ie": 0.11})[0]["kind"] == "kinetic_energy"
+    text = io.StringIO()
+    s["findings"] = findings(s)
+    report(SimpleNamespace(summary=s, complete=True), [], ".", stream=text)
+    lines = text.getvalue().splitlines()
+    assert sum(ln.startswith("  warning: a node penetrated") for ln in lines) == 1
+    assert sum(ln.startswith("  note: ") for ln in lines) == 2 and "x4 with the step cut to 1/4" in text.getvalue()

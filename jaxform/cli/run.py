@@ -23,8 +23,6 @@ FIELD_UNITS = {
 """The VTU point fields of a frame: each name ends with its unit (as in ``wrinkles.vtu``)."""
 
 
-QUASI_STATIC_KE_IE = 0.1
-"""A run whose kinetic energy exceeds this fraction of the internal energy is flagged as not quasi-static."""
 OUTPUTS = ("frames_*.vtu", "frames.pvd", "summary.json", "shear_angle.png", "deviation.png", "punch_force.png")
 """What a run writes into its folder (a rerun replaces all of it)."""
 HALF_SPEED = "half_speed"
@@ -196,10 +194,6 @@ def report(result, written, out, stream=None):
         if s.get("max_ke_ie") is not None:
             print(f", max KE/IE {s['max_ke_ie']:.3g}", end="", file=stream)
         print(file=stream)
-        if s.get("max_ke_ie") is not None and s["max_ke_ie"] > QUASI_STATIC_KE_IE:
-            print(f"  warning: not quasi-static by its own numbers: the kinetic energy reached {s['max_ke_ie']:.3g} x "
-                  f"the internal energy over the last 80% of the stroke (quasi-static: below {QUASI_STATIC_KE_IE:g}); "
-                  "inertia shapes this result. Lower process.speed_mm_per_s.", file=stream)
     n = s.get("numerics") or {}
     if n.get("dt_governed_by"):
         fm = n.get("fibre_mass_scaling", 1.0)
@@ -211,21 +205,8 @@ def report(result, written, out, stream=None):
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
               f"{safety}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
               f"({n.get('speed_choice', 'given')})", file=stream)
-        pen = n.get("max_penetration_ply")
-        if pen is not None and pen > n["penetration_limit_ply"]:
-            print(f"  warning: a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set "
-                  f"for {n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the "
-                  "expected one; raise contact.expected_pressure_Pa for a stiffer contact", file=stream)
-        cuts, k_before = n.get("step_cuts") or [], 1.0
-        for c in cuts:  # at most three: a cut stays
-            where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"
-            if c["contact_stiffness"] > k_before:
-                print(f"  note: the contact was stiffened to x{c['contact_stiffness']:g} with the step cut to 1/{c['cut']} "
-                      f"{where}: the pressures exceed the expected {n['expected_pressure_Pa']:.3g} Pa", file=stream)
-            else:
-                print(f"  note: a chunk failed at the run's step {where}; the run went on with the step cut to "
-                      f"1/{c['cut']}: a fast event, not quasi-static there", file=stream)
-            k_before = c["contact_stiffness"]
+    for f in s.get("findings") or []:
+        print(f"  {f['level']}: {f['text']}", file=stream)
     if "quasi_static_check" in s:
         _report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)

@@ -123,6 +123,46 @@ def _step_cuts(result) -> dict:
             "contact_stiffness_factor": cuts[-1]["contact_stiffness"] if cuts else 1.0}
 
 
+QUASI_STATIC_KE_IE = 0.1
+"""A run whose kinetic energy exceeds this fraction of the internal energy over the last 80 % of the
+stroke is not quasi-static by its own numbers (:func:`findings`)."""
+
+
+def findings(s: dict) -> list[dict]:
+    """What a run's own numbers say against reading it as the quasi-static answer, from its summary
+    ``s``: each ``{"kind", "level", "text"}``, ``level`` "warning" (the result itself is in doubt:
+    ``kinetic_energy`` above :data:`QUASI_STATIC_KE_IE`, a ``penetration`` deeper than the contact
+    was set for) or "note" (a ``step_cut`` or ``contact_stiffened`` by the driver: a fast event,
+    not quasi-static there). ``jaxform run`` prints them; the maps' titles name the warnings."""
+    out = []
+    k = s.get("max_ke_ie")
+    if k is not None and k > QUASI_STATIC_KE_IE:
+        out.append({"kind": "kinetic_energy", "level": "warning", "text": (
+            f"not quasi-static by its own numbers: the kinetic energy reached {k:.3g} x the internal energy over "
+            f"the last 80% of the stroke (quasi-static: below {QUASI_STATIC_KE_IE:g}); inertia shapes this result. "
+            "Lower process.speed_mm_per_s.")})
+    n = s.get("numerics") or {}
+    pen = n.get("max_penetration_ply")
+    if pen is not None and pen > n["penetration_limit_ply"]:
+        out.append({"kind": "penetration", "level": "warning", "text": (
+            f"a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set for "
+            f"{n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the expected "
+            "one; raise contact.expected_pressure_Pa for a stiffer contact")})
+    k_before = 1.0
+    for c in n.get("step_cuts") or []:  # at most three: a cut stays
+        where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"
+        if c["contact_stiffness"] > k_before:
+            out.append({"kind": "contact_stiffened", "level": "note", "text": (
+                f"the contact was stiffened to x{c['contact_stiffness']:g} with the step cut to 1/{c['cut']} {where}: "
+                f"the pressures exceed the expected {n['expected_pressure_Pa']:.3g} Pa")})
+        else:
+            out.append({"kind": "step_cut", "level": "note", "text": (
+                f"a chunk failed at the run's step {where}; the run went on with the step cut to 1/{c['cut']}: a fast "
+                "event, not quasi-static there")})
+        k_before = c["contact_stiffness"]
+    return out
+
+
 def summarize(result) -> dict:
     """The summary of a :class:`~jaxform.forming.driver.FormingResult` (SPEC section 6 keys and more; JSON-ready)."""
     import jaxform
@@ -185,6 +225,7 @@ def summarize(result) -> dict:
         },
         "versions": {"jaxform": jaxform.__version__, "jax": jax.__version__, "numpy": np.__version__},
     }
+    s["findings"] = findings(s)
     return s
 
 
@@ -240,4 +281,5 @@ def quasi_static_check(result, half) -> dict:
 
 
 __all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
+           "QUASI_STATIC_KE_IE", "findings",
            "QUASI_STATIC_LIMITS", "quasi_static_check"]

@@ -17,11 +17,20 @@ def _top_ply(result, k: int = -1):
 
 
 def _title(result, what: str, k: int) -> str:
-    """``"<case>: <what>, punch <d> mm"`` for frame ``k`` (the punch displacement at the frame's time)."""
+    """``"<case>: <what>, punch <d> mm"`` for frame ``k`` (the punch displacement at the frame's time),
+    and below it what speaks against the result: an incomplete run, the warnings of its summary's
+    ``findings`` (:func:`jaxform.forming.summary.findings`: not quasi-static, too deep a penetration)."""
     h = result.history
     t = result.t[k]
     d = float(np.interp(t, h["t_s"], h["punch_displacement_m"])) if len(h["t_s"]) else 0.0
-    return f"{result.info.case.name}: {what}, punch {d * 1e3:.1f} mm"
+    s = getattr(result, "summary", None) or {}
+    doubts = [] if result.complete else ["INCOMPLETE run"]
+    for f in s.get("findings") or []:
+        if f["kind"] == "kinetic_energy":
+            doubts.append(f"NOT quasi-static (KE/IE {s['max_ke_ie']:.2g})")
+        elif f["level"] == "warning":
+            doubts.append(f["kind"])
+    return f"{result.info.case.name}: {what}, punch {d * 1e3:.1f} mm" + ("\n" + "; ".join(doubts) if doubts else "")
 
 
 def shear_map(result, k: int = -1):

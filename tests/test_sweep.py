@@ -186,3 +186,18 @@ def test_sweep_refuses_bad_input_before_it_writes_anything(tmp_path, capsys):
     assert main(["sweep", "case-a-woven-nlbm", "--vary", "fabric.friction_tool=0.2", "--out", str(out),
                  "--coordinator", "127.0.0.1:1", "--quiet"]) == 2
     assert "--num-processes" in capsys.readouterr().err and not out.exists()
+
+
+def test_a_batch_member_whose_blank_is_drawn_into_the_die_stops_as_a_failed_forming():
+    """The 120 mm blank of ``test_a_blank_drawn_into_the_die_stops_the_run_as_a_failed_forming``
+    (drawn in near 27 mm of travel) beside a member that stops at 20 mm: the first fails as a forming,
+    with no remedy tried alone afterwards; the other completes."""
+    from jaxform.forming.health import DRAWN_IN
+
+    case = cases.resolve("case-a-woven-nlbm", element_size=12e-3,
+                         overrides=[*FAST, "blank.size_mm=120", "process.frames=6"])
+    drawn, short = batch.simulate_batch(case, [[], ["process.stroke_mm=20"]])
+    assert drawn.summary["batch"]["members"] == 2
+    assert not drawn.complete and drawn.reason.startswith("the forming failed near step ") and DRAWN_IN in drawn.reason
+    assert "simulation failed" not in drawn.reason and not drawn.step_cuts and drawn.momentum_term_from is None
+    assert short.complete and len(drawn.t) >= 2

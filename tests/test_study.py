@@ -210,6 +210,7 @@ def test_report_from_run_folders(tmp_path):
     assert "+9 %" in claims[8]["why"]
     text = (tmp_path / "report.md").read_text()
     assert "blew up at step 5" in text and "### Claim 1: agree" in text
+    assert "| run | complete | warnings |" in text  # each run's findings that are warnings (none here: "–")
     csv = (tmp_path / "sections" / "case-a-woven-nlbm_A.csv").read_text().splitlines()
     assert csv[0] == "s_mm,amplitude_mm" and len(csv) > 100
     assert (tmp_path / "fig_deviation_case_a_woven.png").is_file()

@@ -253,7 +253,7 @@ def measure_run(run: RunData, *, strokes=()) -> tuple[dict, dict]:
     """
     s = run.summary
     out = {"folder": str(run.folder), "complete": bool(s.get("complete")), "reason": s.get("reason"),
-           "wall_time_s": s.get("wall_time_s"), "max_ke_ie": s.get("max_ke_ie"),
+           "wall_time_s": s.get("wall_time_s"), "max_ke_ie": s.get("max_ke_ie"), "findings": s.get("findings") or [],
            "max_shear_angle_deg": s.get("max_shear_angle_deg"), "draw_in": s.get("draw_in"),
            "numerics": s.get("numerics"), "element_size_m": float(run.case.element_size),
            "frames": len(run.frames)}

@@ -166,15 +166,16 @@ def _fmt(v, scale=1.0, digits=3):
 
 
 def _run_table(runs, measures) -> list[str]:
-    lines = ["| run | complete | wall time, s | steps | dt, s | fibre mass | max KE/IE | max shear, deg | "
-             "edge draw-in, mm | flange wrinkles |", "|---|---|---|---|---|---|---|---|---|---|"]
+    lines = ["| run | complete | warnings | wall time, s | steps | dt, s | fibre mass | max KE/IE | max shear, deg | "
+             "edge draw-in, mm | flange wrinkles |", "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in runs:
         m = measures[r.name]
         n = m.get("numerics") or {}
         p1 = m.get("ply 1") or {}
         di = m.get("draw_in") or {}
         state = "yes" if m.get("complete") else f"no: {m.get('reason')}"
-        lines.append(f"| {r.name} | {state} | {_fmt(m.get('wall_time_s'), digits=4)} | {n.get('n_steps', '–')} | "
+        warn = ", ".join(f["kind"] for f in m.get("findings") or [] if f["level"] == "warning") or "–"
+        lines.append(f"| {r.name} | {state} | {warn} | {_fmt(m.get('wall_time_s'), digits=4)} | {n.get('n_steps', '–')} | "
                      f"{_fmt(n.get('dt_s'))} | {_fmt(n.get('fibre_mass_scaling'))} | {_fmt(m.get('max_ke_ie'))} | "
                      f"{_fmt(m.get('max_shear_angle_deg'))} | {_fmt(di.get('edge_mid_m'), 1e3)} | "
                      f"{p1.get('flange_wrinkles', '–')} |")

@@ -24,7 +24,7 @@ def _title(result, what: str, k: int) -> str:
     t = result.t[k]
     d = float(np.interp(t, h["t_s"], h["punch_displacement_m"])) if len(h["t_s"]) else 0.0
     s = getattr(result, "summary", None) or {}
-    doubts = [] if result.complete else ["INCOMPLETE run"]
+    doubts = [] if getattr(result, "complete", True) else ["INCOMPLETE run"]
     for f in s.get("findings") or []:
         if f["kind"] == "kinetic_energy":
             doubts.append(f"NOT quasi-static (KE/IE {s['max_ke_ie']:.2g})")

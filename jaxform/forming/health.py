@@ -82,8 +82,10 @@ def penetrated(cause: str) -> bool:
 
 
 def drawn_in(cause: str) -> bool:
-    """Whether a failure's cause (``"; "``-joined) says the blank's edge went into the die (:data:`DRAWN_IN`)."""
-    return DRAWN_IN in cause
+    """Whether a failure's cause (``"; "``-joined) is the blank's edge gone into the die (:data:`DRAWN_IN`)
+    and nothing else: beside a numerical cause (a node flung at 100 times the punch speed may be an
+    edge node) it is the numerics' failure first, and the driver's remedies are tried."""
+    return bool(cause) and all(DRAWN_IN in c for c in cause.split("; "))
 
 
 def physical_causes(x, fl, bounds: HealthBounds, stiffen_above: float = np.inf) -> list[str]:
@@ -114,7 +116,7 @@ def physical_causes(x, fl, bounds: HealthBounds, stiffen_above: float = np.inf) 
         causes.append(f"the part left the rig (nodes {far * 1e3:.3g} mm outside the box of twice the blank)")
     if b.edge:
         r = float(np.min(np.hypot(*x[np.asarray(b.edge), :2].T)))
-        if not r >= b.die_opening:
+        if r < b.die_opening:  # a non-finite position is the numerics' (the checks above), not a drawn-in blank
             causes.append(f"{DRAWN_IN} (an edge node {r * 1e3:.3g} mm from the punch axis, inside the die's "
                           f"{b.die_opening * 1e3:.3g} mm opening)")
     return causes
@@ -123,7 +125,7 @@ def physical_causes(x, fl, bounds: HealthBounds, stiffen_above: float = np.inf) 
 def out_of_bounds_message(step: int, t: float, punch_m: float, causes) -> str:
     """The words of a run that left its physical bounds (:func:`physical_causes`)."""
     where = f"near step {step} (t = {t:.6e} s, punch {punch_m * 1e3:.2f} mm)"
-    if any(drawn_in(c) for c in causes):
+    if drawn_in("; ".join(causes)):
         return (f"{FORMING_FAILED} {where}: {'; '.join(causes)}. Nothing held the flange: a ply without the bending "
                 "stiffness to carry the flange's compression (membrane only) under an open holder, or a blank too small "
                 "for the stroke. An outcome of the case, not a numerical failure; the run stops here, the frames up to "

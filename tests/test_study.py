@@ -139,6 +139,8 @@ def test_claim_verdicts_on_constructed_measures():
     assert c1["verdict"] == "agree" and "4 on the x/y axes" in c1["why"]  # lobes on the axes reported apart
     m = dict([_measure("case-a-woven-nlbm", [_w(a) for a in (20, 110, 200, 290)])])
     assert C.claim_1(m)["verdict"] == "partly"  # off the diagonals; dome and symmetry fine
+    c1 = C.claim_1(dict([_measure("case-a-woven-nlbm", lobes)]))  # the lobes alone: nothing inside a quadrant
+    assert c1["verdict"] == "partly" and "so no primary on any diagonal, and 4 on the x/y axes" in c1["why"]
     assert C.claim_1({})["verdict"] == "not measurable"
     # claim 3: counts fall as the stiffness rises (B_inf -> B_41.5 -> B_init)
     dev = {"flange_deviation_m": {"mean": 1e-3}}

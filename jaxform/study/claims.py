@@ -145,9 +145,10 @@ def claim_1(m):
                 "on_axis": [{k: w[k] for k in ("angle_deg", "r_inner_m", "r_outer_m", "width_m", "amplitude_m")}
                             for w in on_axis],
                 "dome_max_deviation_m": dome, "symmetry_deviation": p1["symmetry_deviation"]}
+    primaries = (f"primaries at {', '.join(f'{a:g}' for a in angles.values())} deg ({len(diag)} of 4 on a diagonal)"
+                 if angles else "so no primary on any diagonal")
     why = (f"{len(inside)} census wrinkles inside the quadrants ({', '.join(str(per_q[q]) for q in range(1, 5))} in "
-           f"quadrants 1-4), primaries at {', '.join(f'{a:g}' for a in angles.values())} deg ({len(diag)} of 4 on a "
-           f"diagonal)")
+           f"quadrants 1-4), {primaries}")
     if on_axis:
         wid = np.mean([w["width_m"] for w in on_axis])
         amp = np.mean([w["amplitude_m"] for w in on_axis])

@@ -335,6 +335,8 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
     assert "warning: not quasi-static" in text.getvalue() and f"{ratio:.3g}" in text.getvalue()
     assert [f["kind"] for f in result.summary["findings"] if f["level"] == "warning"] == ["kinetic_energy"]
     assert json.loads((tmp_out / "summary.json").read_text())["findings"] == result.summary["findings"]
+    sym = result.summary["half_turn_symmetry"]  # a symmetric case, meshed symmetrically: kept to rounding
+    assert sym["deviation"] < 1e-3 and sym["shear_angle"] < 1e-3 and sym["broken_between_punch_m"] is None, sym
     for fig in (fplots.shear_map(result), fplots.deviation_map(result)):
         head, doubt = fig.axes[0].get_title().split("\n")
         assert head.startswith("case-a-woven-nlbm:") and head.endswith("punch 4.0 mm"), head
@@ -357,9 +359,45 @@ def test_findings_say_what_speaks_against_a_result_and_the_report_prints_each():
         ("penetration", "warning"), ("step_cut", "note"), ("contact_stiffened", "note")]
     quiet = {**s, "numerics": {**n, "max_penetration_ply": 0.05, "step_cuts": []}}
     assert findings(quiet) == [] and findings({**quiet, "max_ke_ie": 0.11})[0]["kind"] == "kinetic_energy"
+    sym = {"deviation": 0.19, "tolerance": 0.2, "broken_between_punch_m": None,
+           "edge_mid_pairs_m": [[0.018, 0.017], [0.0275, 0.001]]}
+    assert findings({**quiet, "half_turn_symmetry": sym}) == []
+    broken = {**sym, "deviation": 0.99, "broken_between_punch_m": [0.0395, 0.04475]}
+    (f,) = findings({**quiet, "half_turn_symmetry": broken})
+    assert (f["kind"], f["level"]) == ("asymmetric", "warning")
+    assert "up to 99 %" in f["text"] and "27.5 / 1.0 mm (+y / -y)" in f["text"] and "between 39.5 and 44.8 mm" in f["text"]
     text = io.StringIO()
     s["findings"] = findings(s)
     report(SimpleNamespace(summary=s, complete=True), [], ".", stream=text)
     lines = text.getvalue().splitlines()
     assert sum(ln.startswith("  warning: a node penetrated") for ln in lines) == 1
     assert sum(ln.startswith("  note: ") for ln in lines) == 2 and "x4 with the step cut to 1/4" in text.getvalue()
+
+
+def test_half_turn_symmetry_measures_ply_1_against_its_image_and_says_where_it_broke():
+    """The case is the same turned half a turn about the punch axis; a result that is not says so,
+    and between which frames it stopped being so (a stand-in result: a 5 x 5 grid, three frames)."""
+    import dataclasses
+    from types import SimpleNamespace
+
+    from jaxform import cases
+    from jaxform.forming.summary import HALF_TURN_TOL, half_turn_symmetry
+
+    case = cases.load("case-a-woven-nlbm")
+    g = np.linspace(-0.1, 0.1, 5)
+    x0 = np.array([(a, b, 0.0) for b in g for a in g])
+    bump = np.exp(-((x0[:, 0] - 0.1) ** 2 + x0[:, 1] ** 2) / 1e-3)  # at +x only
+    even = 1e-3 * np.hypot(x0[:, 0], x0[:, 1])  # keeps the half-turn
+    dev = np.stack([even, even + 0.02e-3 * bump, even + 3e-3 * bump])
+    info = SimpleNamespace(case=case, x0=x0, edge_mid=np.array([14, 10, 22, 2]), corners=np.array([0, 4, 20, 24]))
+    x = np.stack([x0, x0, x0 - 0.01 * bump[:, None] * np.array([1.0, 0.0, 0.0])])
+    r = SimpleNamespace(info=info, ply_id=np.ones(25, int), x=x, t=np.array([0.0, 1.0, 2.0]),
+                        fields={"deviation": dev, "shear_angle": np.zeros((3, 25))},
+                        history={"t_s": np.array([0.0, 2.0]), "punch_displacement_m": np.array([0.0, -0.04])})
+    sym = half_turn_symmetry(r)
+    assert sym["deviation_per_frame"][0] < 1e-12 and 0.0 < sym["deviation_per_frame"][1] < HALF_TURN_TOL
+    assert sym["deviation"] == pytest.approx(3e-3 / (1e-3 * 0.1 + 3e-3), rel=1e-6) and sym["deviation"] > HALF_TURN_TOL
+    assert sym["broken_between_punch_m"] == pytest.approx([0.02, 0.04]) and sym["shear_angle"] == 0.0
+    assert sym["edge_mid_pairs_m"][0] == pytest.approx([0.01, 0.0]) and sym["edge_mid_pairs_m"][1] == [0.0, 0.0]
+    tools = dataclasses.replace(case.tools, punch_mesh="punch.stl")
+    assert half_turn_symmetry(SimpleNamespace(**{**vars(r), "info": SimpleNamespace(**{**vars(info), "case": dataclasses.replace(case, tools=tools)})})) is None

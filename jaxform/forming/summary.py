@@ -83,6 +83,49 @@ def shear_mirror_odd(case, ply: int = 1) -> bool:
     return along_edges([a + o for a in fabric_preset(case.fabric.preset).fibre_angles])
 
 
+HALF_TURN_TOL = 0.2
+"""The largest half-turn asymmetry of ply 1's deviation from the tools (a fraction of its largest
+value, :func:`half_turn_symmetry`) a run may end with before :func:`findings` warns. Rounding alone
+gives a few %: woven Case A NLBM at 2 mm as shipped 5.8 % (4.1 % at half speed) at the last frame;
+NCF Case A NLBM at 4 mm, whose flange snapped on one side at 45 mm, 99-100 %."""
+
+
+def half_turn_symmetry(result) -> dict | None:
+    """How far ply 1's result is from the half-turn symmetry of the case, or None where the case
+    has none to keep (a punch from a mesh file) or the run wrote no frame.
+
+    The hemisphere rig's tools are axisymmetric and the blank is a square centred on the punch
+    axis, meshed symmetrically, so a rotation by 180 deg about the axis maps the case onto itself
+    whatever the fibre layout (each fibre onto a fibre, the shear angle and the deviation onto
+    themselves); a deterministic answer keeps that symmetry. Returns ``deviation`` and
+    ``shear_angle``: ``max |v - v(rot180)| / max(max |v|, floor)`` at the last frame (floor: the
+    ply thickness, resp. one degree); ``deviation_per_frame``; ``broken_between_punch_m``: the
+    punch travel of the last frame within :data:`HALF_TURN_TOL` before the frames that all exceed it
+    and of the first of them (None while the last frame is within it); ``edge_mid_pairs_m``: the
+    edge mid-side draw-in ``[[+x, -x], [+y, -y]]``; ``tolerance``.
+    """
+    case, info = result.info.case, result.info
+    dev = result.fields.get("deviation")
+    if case.tools.punch_mesh is not None or dev is None or not len(dev):
+        return None
+    top = np.asarray(result.ply_id) == 1
+    idx = mirror_index(info.x0[top], -1, -1)
+    d = np.asarray(dev)[:, top]
+    per = np.max(np.abs(d - d[:, idx]), axis=1) / np.maximum(np.max(np.abs(d), axis=1), float(case.ply_thickness))
+    g = np.asarray(result.fields["shear_angle"][-1])[top]
+    shear = float(np.max(np.abs(g - g[idx])) / max(float(np.max(np.abs(g))), math.radians(1.0)))
+    h = result.history
+    depth = np.abs(np.interp(np.asarray(result.t)[:len(per)], h["t_s"], h["punch_displacement_m"]))
+    within = np.flatnonzero(per <= HALF_TURN_TOL)
+    broken = None
+    if per[-1] > HALF_TURN_TOL:
+        k = int(within[-1]) + 1 if within.size else 0
+        broken = [float(depth[k - 1]) if k else 0.0, float(depth[k])]
+    mid = draw_in(result.x[-1], info)["edge_mid_each_m"]
+    return {"deviation": float(per[-1]), "shear_angle": shear, "deviation_per_frame": per.tolist(),
+            "broken_between_punch_m": broken, "edge_mid_pairs_m": [mid[:2], mid[2:]], "tolerance": HALF_TURN_TOL}
+
+
 def _step_choice(info, history) -> dict:
     """How the step and the contact stiffness were chosen (:func:`jaxform.forming.numerics.contact_numerics`),
     and the deepest penetration the run's samples saw, as a fraction of the ply thickness (the
@@ -132,7 +175,7 @@ def findings(s: dict) -> list[dict]:
     """What a run's own numbers say against reading it as the quasi-static answer, from its summary
     ``s``: each ``{"kind", "level", "text"}``, ``level`` "warning" (the result itself is in doubt:
     ``kinetic_energy`` above :data:`QUASI_STATIC_KE_IE`, a ``penetration`` deeper than the contact
-    was set for) or "note" (a ``step_cut`` or ``contact_stiffened`` by the driver: a fast event,
+    was set for, an ``asymmetric`` result beyond :data:`HALF_TURN_TOL`) or "note" (a ``step_cut`` or ``contact_stiffened`` by the driver: a fast event,
     not quasi-static there). ``jaxform run`` prints them; the maps' titles name the warnings."""
     out = []
     k = s.get("max_ke_ie")
@@ -148,6 +191,17 @@ def findings(s: dict) -> list[dict]:
             f"a node penetrated a tool or ply by {pen:.3g} x the ply thickness (the contact is set for "
             f"{n['penetration_limit_ply']:g} at {n['expected_pressure_Pa']:.3g} Pa): the pressures exceed the expected "
             "one; raise contact.expected_pressure_Pa for a stiffer contact")})
+    sym = s.get("half_turn_symmetry")
+    if sym and sym["deviation"] > sym["tolerance"]:
+        (px, mx), (py, my) = (1e3 * np.asarray(p) for p in sym["edge_mid_pairs_m"])
+        lo, hi = (1e3 * v for v in sym["broken_between_punch_m"])
+        out.append({"kind": "asymmetric", "level": "warning", "text": (
+            f"the result has lost the case's symmetry: turned half a turn about the punch axis the case is the same "
+            f"(axisymmetric tools, a centred blank), but ply 1's deviation from the tools differs from its image by up "
+            f"to {100 * sym['deviation']:.0f} % of its largest value (rounding alone: a few %), and the edge mid-sides "
+            f"drew in {px:.1f} / {mx:.1f} mm (+x / -x) and {py:.1f} / {my:.1f} mm (+y / -y). It set in between "
+            f"{lo:.1f} and {hi:.1f} mm of punch travel, where a buckle or a snap took one side: this is one of the "
+            "results the run could have given, not the converged answer (--verify-quasi-static compares another).")})
     k_before = 1.0
     for c in n.get("step_cuts") or []:  # at most three: a cut stays
         where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"
@@ -225,6 +279,7 @@ def summarize(result) -> dict:
         },
         "versions": {"jaxform": jaxform.__version__, "jax": jax.__version__, "numpy": np.__version__},
     }
+    s["half_turn_symmetry"] = half_turn_symmetry(result)
     s["findings"] = findings(s)
     return s
 
@@ -246,8 +301,8 @@ def quasi_static_check(result, half) -> dict:
     along the stroke, ``shear_p95_deg_per_frame`` at ``punch_mm_per_frame`` and
     ``shear_agrees_to_punch_mm``, the punch travel after which the maps differ beyond the limit at
     every frame to the end (the full stroke where the last frame agrees; ``None`` where none does):
-    where a run leaves quasi-static for good (NCF Case A at 4 mm: 35 mm of its 50, then its
-    softening shear law snaps; woven LBM B_inf: 35 mm too, after a start-up transient at 5 mm
+    where a run leaves quasi-static for good (NCF Case A at 4 mm: 35 mm of its 50, then the
+    shear law's tangent drops 5.4x and the flange snaps; woven LBM B_inf: 35 mm too, after a start-up transient at 5 mm
     that the later frames forget). A check that cannot be made (a run incomplete, or no frame) says
     why in ``reason`` and is not passed.
     """
@@ -281,5 +336,5 @@ def quasi_static_check(result, half) -> dict:
 
 
 __all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
-           "QUASI_STATIC_KE_IE", "findings",
+           "QUASI_STATIC_KE_IE", "findings", "HALF_TURN_TOL", "half_turn_symmetry",
            "QUASI_STATIC_LIMITS", "quasi_static_check"]

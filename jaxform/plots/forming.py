@@ -19,7 +19,8 @@ def _top_ply(result, k: int = -1):
 def _title(result, what: str, k: int) -> str:
     """``"<case>: <what>, punch <d> mm"`` for frame ``k`` (the punch displacement at the frame's time),
     and below it what speaks against the result: an incomplete run, the warnings of its summary's
-    ``findings`` (:func:`jaxform.forming.summary.findings`: not quasi-static, too deep a penetration)."""
+    ``findings`` (:func:`jaxform.forming.summary.findings`: not quasi-static, too deep a penetration,
+    the case's symmetry lost)."""
     h = result.history
     t = result.t[k]
     d = float(np.interp(t, h["t_s"], h["punch_displacement_m"])) if len(h["t_s"]) else 0.0
@@ -28,6 +29,8 @@ def _title(result, what: str, k: int) -> str:
     for f in s.get("findings") or []:
         if f["kind"] == "kinetic_energy":
             doubts.append(f"NOT quasi-static (KE/IE {s['max_ke_ie']:.2g})")
+        elif f["kind"] == "asymmetric":
+            doubts.append(f"NOT symmetric ({100 * s['half_turn_symmetry']['deviation']:.0f} % off its half-turn)")
         elif f["level"] == "warning":
             doubts.append(f["kind"])
     return f"{result.info.case.name}: {what}, punch {d * 1e3:.1f} mm" + ("\n" + "; ".join(doubts) if doubts else "")

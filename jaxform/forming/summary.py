@@ -86,8 +86,10 @@ def shear_mirror_odd(case, ply: int = 1) -> bool:
 HALF_TURN_TOL = 0.2
 """The largest half-turn asymmetry of ply 1's deviation from the tools (a fraction of its largest
 value, :func:`half_turn_symmetry`) a run may end with before :func:`findings` warns. Rounding alone
-gives a few %: woven Case A NLBM at 2 mm as shipped 5.8 % (4.1 % at half speed) at the last frame;
-NCF Case A NLBM at 4 mm, whose flange snapped on one side at 45 mm, 99-100 %."""
+gives a few %: woven Case A NLBM at 2 mm as shipped 5.8 % (4.1 % at half speed) at the last frame,
+NCF LBM B_init at 4 mm 0.4 %. NCF Case A at 4 mm as shipped: NLBM 100 % (its flange folded on one
+side only, from 40-45 mm), LBM B_inf 100 % (wrinkles without images, from 29-34 mm; still 100 %
+where each may shift by 10 mm to meet one), membrane-only 98 % (from 13-19 mm)."""
 
 
 def half_turn_symmetry(result) -> dict | None:
@@ -200,8 +202,9 @@ def findings(s: dict) -> list[dict]:
             f"(axisymmetric tools, a centred blank), but ply 1's deviation from the tools differs from its image by up "
             f"to {100 * sym['deviation']:.0f} % of its largest value (rounding alone: a few %), and the edge mid-sides "
             f"drew in {px:.1f} / {mx:.1f} mm (+x / -x) and {py:.1f} / {my:.1f} mm (+y / -y). It set in between "
-            f"{lo:.1f} and {hi:.1f} mm of punch travel, where a buckle or a snap took one side: this is one of the "
-            "results the run could have given, not the converged answer (--verify-quasi-static compares another).")})
+            f"{lo:.1f} and {hi:.1f} mm of punch travel: from there the buckling chose among patterns the case does not "
+            "tell apart (where the wrinkles lie, or a snap on one side), so this is one of the results the run could "
+            "have given, not the converged answer (--verify-quasi-static compares another).")})
     k_before = 1.0
     for c in n.get("step_cuts") or []:  # at most three: a cut stays
         where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"

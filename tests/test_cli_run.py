@@ -399,5 +399,6 @@ def test_half_turn_symmetry_measures_ply_1_against_its_image_and_says_where_it_b
     assert sym["deviation"] == pytest.approx(3e-3 / (1e-3 * 0.1 + 3e-3), rel=1e-6) and sym["deviation"] > HALF_TURN_TOL
     assert sym["broken_between_punch_m"] == pytest.approx([0.02, 0.04]) and sym["shear_angle"] == 0.0
     assert sym["edge_mid_pairs_m"][0] == pytest.approx([0.01, 0.0]) and sym["edge_mid_pairs_m"][1] == [0.0, 0.0]
-    tools = dataclasses.replace(case.tools, punch_mesh="punch.stl")
-    assert half_turn_symmetry(SimpleNamespace(**{**vars(r), "info": SimpleNamespace(**{**vars(info), "case": dataclasses.replace(case, tools=tools)})})) is None
+    stl = dataclasses.replace(case, tools=dataclasses.replace(case.tools, punch_mesh="punch.stl"))
+    r.info = SimpleNamespace(**{**vars(info), "case": stl})  # a punch from a file: no symmetry to keep
+    assert half_turn_symmetry(r) is None

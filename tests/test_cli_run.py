@@ -365,7 +365,8 @@ def test_findings_say_what_speaks_against_a_result_and_the_report_prints_each():
     broken = {**sym, "deviation": 0.99, "broken_between_punch_m": [0.0395, 0.04475]}
     (f,) = findings({**quiet, "half_turn_symmetry": broken})
     assert (f["kind"], f["level"]) == ("asymmetric", "warning")
-    assert "up to 99 %" in f["text"] and "27.5 / 1.0 mm (+y / -y)" in f["text"] and "between 39.5 and 44.8 mm" in f["text"]
+    for part in ("up to 99 %", "27.5 / 1.0 mm (+y / -y)", "between 39.5 and 44.8 mm"):
+        assert part in f["text"], part
     text = io.StringIO()
     s["findings"] = findings(s)
     report(SimpleNamespace(summary=s, complete=True), [], ".", stream=text)

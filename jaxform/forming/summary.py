@@ -178,7 +178,8 @@ def findings(s: dict) -> list[dict]:
     ``s``: each ``{"kind", "level", "text"}``, ``level`` "warning" (the result itself is in doubt:
     ``kinetic_energy`` above :data:`QUASI_STATIC_KE_IE`, a ``penetration`` deeper than the contact
     was set for, an ``asymmetric`` result beyond :data:`HALF_TURN_TOL`) or "note" (a ``step_cut``
-    or ``contact_stiffened`` by the driver: a fast event, not quasi-static there). ``jaxform run`` prints them; the maps' titles name the warnings."""
+    or ``contact_stiffened`` by the driver: a fast event, not quasi-static there). ``jaxform run``
+    prints them; the maps' titles name the warnings."""
     out = []
     k = s.get("max_ke_ie")
     if k is not None and k > QUASI_STATIC_KE_IE:
@@ -306,8 +307,8 @@ def quasi_static_check(result, half) -> dict:
     every frame to the end (the full stroke where the last frame agrees; ``None`` where none does):
     where a run leaves quasi-static for good (NCF Case A at 4 mm: 35 mm of its 50, then the
     shear law's tangent drops 5.4x and the flange snaps; woven LBM B_inf: 35 mm too, after a
-    start-up transient at 5 mm that the later frames forget). A check that cannot be made (a run incomplete, or no frame) says
-    why in ``reason`` and is not passed.
+    start-up transient at 5 mm that the later frames forget). A check that cannot be made (a run
+    incomplete, or no frame) says why in ``reason`` and is not passed.
     """
     out = {"speed_mm_per_s": 1e3 * float(result.info.case.process.speed),
            "half_speed_mm_per_s": 1e3 * float(half.info.case.process.speed),

@@ -382,6 +382,7 @@ def test_half_turn_symmetry_measures_ply_1_against_its_image_and_says_where_it_b
     from types import SimpleNamespace
 
     from jaxform import cases
+    from jaxform.forming.rig import grid_quads
     from jaxform.forming.summary import HALF_TURN_TOL, half_turn_symmetry
 
     case = cases.load("case-a-woven-nlbm")
@@ -392,14 +393,19 @@ def test_half_turn_symmetry_measures_ply_1_against_its_image_and_says_where_it_b
     dev = np.stack([even, even + 0.02e-3 * bump, even + 3e-3 * bump])
     info = SimpleNamespace(case=case, x0=x0, edge_mid=np.array([14, 10, 22, 2]), corners=np.array([0, 4, 20, 24]))
     x = np.stack([x0, x0, x0 - 0.01 * bump[:, None] * np.array([1.0, 0.0, 0.0])])
-    r = SimpleNamespace(info=info, ply_id=np.ones(25, int), x=x, t=np.array([0.0, 1.0, 2.0]),
+    r = SimpleNamespace(info=info, ply_id=np.ones(25, int), x=x, t=np.array([0.0, 1.0, 2.0]), faces=grid_quads(5, 5),
                         fields={"deviation": dev, "shear_angle": np.zeros((3, 25))},
                         history={"t_s": np.array([0.0, 2.0]), "punch_displacement_m": np.array([0.0, -0.04])})
     sym = half_turn_symmetry(r)
     assert sym["deviation_per_frame"][0] < 1e-12 and 0.0 < sym["deviation_per_frame"][1] < HALF_TURN_TOL
-    assert sym["deviation"] == pytest.approx(3e-3 / (1e-3 * 0.1 + 3e-3), rel=1e-6) and sym["deviation"] > HALF_TURN_TOL
+    ring = 1e-3 * np.hypot(0.1, 0.05)  # the highest value around the image (-0.1, 0): the ring's corners
+    assert sym["deviation"] == pytest.approx((1e-3 * 0.1 + 3e-3 - ring) / (1e-3 * 0.1 + 3e-3), rel=1e-5)
+    assert sym["deviation"] > HALF_TURN_TOL
     assert sym["broken_between_punch_m"] == pytest.approx([0.02, 0.04]) and sym["shear_angle"] == 0.0
     assert sym["edge_mid_pairs_m"][0] == pytest.approx([0.01, 0.0]) and sym["edge_mid_pairs_m"][1] == [0.0, 0.0]
+    shifted = np.exp(-((x0[:, 0] + 0.1) ** 2 + (x0[:, 1] - 0.05) ** 2) / 1e-3)  # its image, one element off
+    r.fields = {**r.fields, "deviation": np.stack([even, even, even + 3e-3 * (bump + shifted)])}
+    assert half_turn_symmetry(r)["deviation"] < 0.02  # matched within the image's one ring (node by node: 0.9)
     stl = dataclasses.replace(case, tools=dataclasses.replace(case.tools, punch_mesh="punch.stl"))
     r.info = SimpleNamespace(**{**vars(info), "case": stl})  # a punch from a file: no symmetry to keep
     assert half_turn_symmetry(r) is None

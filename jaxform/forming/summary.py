@@ -92,6 +92,13 @@ NLBM 99.5 % (its flange folded on one side only, from 40-45 mm), LBM B_inf 100 %
 images, from 34-40 mm), membrane-only 94 % (from 13-19 mm)."""
 
 
+def _ply_1(result):
+    """``(top, faces)``: the (N,) mask of ply 1's nodes and its faces with node indices within it."""
+    top = np.asarray(result.ply_id) == 1
+    faces = np.asarray(result.faces)
+    return top, (np.cumsum(top) - 1)[faces[np.all(top[faces], axis=1)]]
+
+
 def _off_image(v, image, faces):
     """(F,) for nodal values ``v`` (F, N): the largest distance of a node's value from the range its
     image node's one ring (the faces around it, ``faces`` (M, k)) spans, so that a feature one
@@ -116,19 +123,18 @@ def half_turn_symmetry(result) -> dict | None:
     themselves); a deterministic answer keeps that symmetry. Returns ``deviation`` and
     ``shear_angle``: how far a node's value lies outside the range of its image's one ring (a
     feature one element off its image matches it), at most, over ``max(max |v|, floor)``, at the
-    last frame (floor: the ply thickness, resp. one degree); ``deviation_per_frame``; ``broken_between_punch_m``: the
-    punch travel of the last frame within :data:`HALF_TURN_TOL` before the frames that all exceed it
-    and of the first of them (None while the last frame is within it); ``edge_mid_pairs_m``: the
-    edge mid-side draw-in ``[[+x, -x], [+y, -y]]``; ``tolerance``.
+    last frame (floor: the ply thickness, resp. one degree); ``deviation_per_frame``;
+    ``broken_between_punch_m``: the punch travel of the last frame within :data:`HALF_TURN_TOL`
+    before the frames that all exceed it and of the first of them (None while the last frame is
+    within it); ``edge_mid_pairs_m``: the edge mid-side draw-in ``[[+x, -x], [+y, -y]]``;
+    ``tolerance``.
     """
     case, info = result.info.case, result.info
     dev = result.fields.get("deviation")
     if case.tools.punch_mesh is not None or dev is None or not len(dev):
         return None
-    top = np.asarray(result.ply_id) == 1
+    top, faces = _ply_1(result)
     idx = mirror_index(info.x0[top], -1, -1)
-    local = np.cumsum(top) - 1
-    faces = local[np.asarray(result.faces)[np.all(top[np.asarray(result.faces)], axis=1)]]
     d = np.asarray(dev)[:, top]
     per = _off_image(d, idx, faces) / np.maximum(np.max(np.abs(d), axis=1), float(case.ply_thickness))
     g = np.asarray(result.fields["shear_angle"][-1:])[:, top]
@@ -262,10 +268,8 @@ def summarize(result) -> dict:
     max_dev = float(np.max(dev[-1][flange])) if dev is not None and len(dev) else None
     census = None
     if dev is not None and len(dev):
-        top = result.ply_id == 1
-        local = np.cumsum(top) - 1  # node index within ply 1
-        faces = result.faces[np.all(top[result.faces], axis=1)]
-        census = flange_census(result.x[-1][top], dev[-1][top], local[faces], case)
+        top, faces = _ply_1(result)
+        census = flange_census(result.x[-1][top], dev[-1][top], faces, case)
     s = {
         "complete": bool(result.complete),
         "reason": result.reason,

@@ -181,7 +181,7 @@ def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_sta
     tight = numerics.contact_numerics(case4, fabs, stable, None, 0.9)
     assert tight.safety == numerics.AUTO_SAFETY and tight.budget > numerics.STEP_BUDGET
     case, stable, n = _numerics("case-a-woven-nlbm", 2.0, "numerics.fibre_mass_scaling=12",
-                                "contact.expected_pressure_Pa=1e5")
+                                "contact.expected_pressure_Pa=1e5", "contact.implicit_normal=false")
     assert n.governed_by == "contact" and n.dt_max < 0.75 * stable
     assert n.budget == pytest.approx(numerics.STEP_BUDGET)
     rho, h = float(_areal_mass(case)), case.ply_thickness
@@ -197,7 +197,7 @@ def test_automatic_contact_numerics_keep_the_contact_stiff_and_four_contacts_sta
     steps = {}
     for p in ("1e4", "1e5"):
         case, stable, n = _numerics("case-a-woven-nlbm", 8.0, "numerics.fibre_mass_scaling=12",
-                                    f"contact.expected_pressure_Pa={p}")
+                                    f"contact.expected_pressure_Pa={p}", "contact.implicit_normal=false")
         assert n.budget == pytest.approx(numerics.STEP_BUDGET) and f"at {float(p):.3g} Pa" in n.why
         assert n.safety * rho / n.dt_max**2 == pytest.approx(1.02 * float(p) / (0.1 * h))
         steps[p] = n.dt_max
@@ -223,6 +223,36 @@ def test_with_the_normal_forces_integrated_backward_the_contact_takes_nothing_fr
             _numerics(name, 8.0, *keys)
 
 
+def test_the_normal_forces_are_integrated_backward_by_default_only_where_the_explicit_contact_would_set_the_step():
+    """contact.implicit_normal = "auto" (the default): woven Case A at 8 mm, where the explicit
+    10 kPa contact would set the step, gets the backward normal and the shell's step (0.75 x its
+    stable step, longer than the explicit choice), and says why; at 4 mm the shell sets the
+    explicit step already, so the contact stays explicit; so it does under a clamped holder
+    (Case B), for a stack, and where the user gave the contact's safety; true / false are kept;
+    a value other than true, false or "auto" is refused at the edge."""
+    from jaxform.forming import case as case_mod
+
+    FM12 = "numerics.fibre_mass_scaling=12"  # the automatic factor at these sizes, without its host eigensolve
+
+    case, stable, auto = _numerics("case-a-woven-nlbm", 8.0, FM12)
+    _, _, explicit = _numerics("case-a-woven-nlbm", 8.0, FM12, "contact.implicit_normal=false")
+    assert case.contact.implicit_normal is None and case_mod.to_dict(case)["contact"]["implicit_normal"] == "auto"
+    assert explicit.governed_by == "contact" and not explicit.implicit_normal
+    assert auto.implicit_normal and (auto.governed_by, auto.dt_max) == ("shell", pytest.approx(0.75 * stable))
+    assert auto.dt_max > 1.3 * explicit.dt_max
+    assert "implicit_normal auto" in auto.why and f"{explicit.dt_max:.3g} s" in auto.why
+    _, _, forced = _numerics("case-a-woven-nlbm", 8.0, FM12, "contact.implicit_normal=true")
+    assert forced.implicit_normal and forced.dt_max == auto.dt_max
+    for name, size, keys in (("case-a-woven-nlbm", 4.0, ()),  # the shell sets the step
+                             ("case-b-woven-nlbm", 8.0, ()),  # a clamped holder
+                             ("case-a-woven-nlbm", 8.0, ("plies.orientations_deg=[0.0, 90.0]",)),  # a stack
+                             ("case-a-woven-nlbm", 8.0, ("contact.safety=0.2",))):  # the user's contact
+        _, _, n = _numerics(name, size, FM12, *keys)
+        assert not n.implicit_normal, (name, size, keys, n.why)
+    with pytest.raises(ValueError, match='implicit_normal.*must be true or false, or "auto"'):
+        _numerics("case-a-woven-nlbm", 8.0, FM12, "contact.implicit_normal=1")
+
+
 def test_a_run_with_the_normal_forces_integrated_backward_forms_the_part_at_the_shell_s_step():
     """Woven Case A, 25 mm, 15 mm of stroke with contact.implicit_normal: the step is the shell's
     (longer than the explicit contact's), the run completes, the ply lies on the punch within 10 %
@@ -234,7 +264,8 @@ def test_a_run_with_the_normal_forces_integrated_backward_forms_the_part_at_the_
     assert s["dt_governed_by"] == "shell" and s["max_penetration_ply"] < 0.1
     from jaxform.forming import numerics, rig
 
-    explicit = _coarse("case-a-woven-nlbm", process__stroke_mm=15, process__frames=3)  # host only: no second rig
+    explicit = _coarse("case-a-woven-nlbm", process__stroke_mm=15, process__frames=3,
+                       contact__implicit_normal="false")  # host only: no second rig
     n_e = numerics.contact_numerics(explicit, rig.ply_fabrics(explicit), r.info.stable_dt, None, 0.75)
     assert r.info.numerics.dt_max >= n_e.dt_max
     assert float(np.max(r.history["punch_force_N"])) > 0

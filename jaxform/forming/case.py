@@ -27,7 +27,7 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
                damping_ratio, optional self_contact (default true: folds lie on themselves),
                optional expected_pressure_Pa ("auto", the default, or > 0: the contact pressure
                the penalty keeps below 10% of the ply, jaxform.forming.numerics.expected_pressure),
-               optional implicit_normal (default false; true: jaxform.backward_normal, one ply, a gap holder)
+               optional implicit_normal ("auto", the default, true or false: jaxform.forming.numerics.contact_numerics)
     [numerics] dtype = "float32" | "float64", mass_scaling, optional fibre_mass_scaling ("auto", the
                default: jaxform.forming.numerics.auto_fibre_mass; or a number >= 1, 1 = off:
                inertia added to fibre stretching only, the membrane limit of the step grows by
@@ -111,12 +111,12 @@ class ProcessSpec:
 
 @dataclasses.dataclass(frozen=True)
 class ContactSpec:
-    """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.penalty.contact_params`), its
-    stability ``safety`` (``(omega_c dt)^2`` of one contact; ``None``: automatic, chosen with the
-    time step by :func:`jaxform.forming.numerics.contact_numerics`), friction regularisation speed as a fraction of the punch speed, normal
-    damping ratio; ``self_contact``: every ply with itself and the plies not next to it
-    (:mod:`jaxform.self_contact`, on by default); ``expected_pressure``: Pa (``None``: automatic,
-    :func:`jaxform.forming.numerics.expected_pressure`); ``implicit_normal``: normal forces backward (:mod:`jaxform.backward_normal`)."""
+    """Penalty stiffness Pa/m (``None``: automatic, :func:`jaxform.penalty.contact_params`), its stability
+    ``safety`` (``(omega_c dt)^2`` of one contact), friction regularisation speed as a fraction of the punch
+    speed, normal damping ratio; ``self_contact``: every ply with itself and the plies not next to it
+    (:mod:`jaxform.self_contact`, on by default); ``expected_pressure``: Pa; ``implicit_normal``: normal
+    forces backward (:mod:`jaxform.backward_normal`). ``None``: automatic (``safety``, ``expected_pressure``
+    and ``implicit_normal``: :mod:`jaxform.forming.numerics`)."""
 
     penalty_stiffness: float | None
     safety: float | None
@@ -124,7 +124,7 @@ class ContactSpec:
     damping_ratio: float
     self_contact: bool = True
     expected_pressure: float | None = None
-    implicit_normal: bool = False
+    implicit_normal: bool | None = None
 
 
 @dataclasses.dataclass(frozen=True)
@@ -191,7 +191,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
                 "ramp_fraction": ("float", True), "frames": ("int", True)},
     "contact": {"penalty_stiffness_Pa_per_m": ("auto", True), "safety": ("auto", True),
                 "slip_velocity_fraction": ("float", True), "damping_ratio": ("float", True),
-                "self_contact": ("bool", False), "expected_pressure_Pa": ("auto", False), "implicit_normal": ("bool", False)},
+                "self_contact": ("bool", False), "expected_pressure_Pa": ("auto", False), "implicit_normal": ("bool_auto", False)},
     "numerics": {"dtype": ("str", True), "mass_scaling": ("float", True), "fibre_mass_scaling": ("auto", False),
                  "fibre_mass_momentum_term": ("bool", False)},
 }
@@ -207,9 +207,9 @@ def _typed(key: str, kind: str, value: Any):
         if not isinstance(value, str):
             raise _err(key, value, "must be a string")
         return value
-    if kind == "bool":
-        if not isinstance(value, bool):
-            raise _err(key, value, "must be true or false")
+    if kind in ("bool", "bool_auto"):
+        if not isinstance(value, bool) and not (kind == "bool_auto" and value == "auto"):
+            raise _err(key, value, "must be true or false" + (', or "auto"' if kind == "bool_auto" else ""))
         return value
     if kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
@@ -378,7 +378,7 @@ def _build(d) -> Case:
     contact_spec = ContactSpec(penalty_stiffness=None if k == "auto" else k, safety=None if safety == "auto" else safety,
                                slip_velocity_fraction=c["slip_velocity_fraction"], damping_ratio=c["damping_ratio"],
                                self_contact=c.get("self_contact", True), expected_pressure=None if pe == "auto" else pe,
-                               implicit_normal=c.get("implicit_normal", False))
+                               implicit_normal=None if (im := c.get("implicit_normal", "auto")) == "auto" else im)
 
     n = d["numerics"]
     if n["dtype"] not in ("float32", "float64"):
@@ -510,7 +510,7 @@ def to_dict(case: Case) -> dict:
                     "safety": "auto" if c.safety is None else c.safety, "slip_velocity_fraction": c.slip_velocity_fraction,
                     "damping_ratio": c.damping_ratio, "self_contact": c.self_contact,
                     "expected_pressure_Pa": "auto" if c.expected_pressure is None else c.expected_pressure,
-                    "implicit_normal": c.implicit_normal},
+                    "implicit_normal": "auto" if c.implicit_normal is None else c.implicit_normal},
         "numerics": numerics,
     }
 

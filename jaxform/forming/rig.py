@@ -259,8 +259,10 @@ def _time_step(case: Case, numerics: ContactNumerics, samples_per_frame: int):
     return T / (n_int * every), every, T
 
 
-def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | None = None):
-    """The contact loads in ``model.loads`` order and their initial holder state."""
+def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | None = None,
+           implicit_normal: bool = False):
+    """The contact loads in ``model.loads`` order and their initial holder state; ``implicit_normal``
+    as chosen by :func:`jaxform.forming.numerics.contact_numerics`."""
     tools_rig = build_tools(case)
     h = float(case.ply_thickness)
     fab0 = fabrics[0]
@@ -268,7 +270,7 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     c = case.contact
     speed = float(case.process.speed)
     k = c.penalty_stiffness
-    if c.implicit_normal and k is None and safety is not None:  # any stiffness is stable: no bound on the safety
+    if implicit_normal and k is None and safety is not None:  # any stiffness is stable: no bound on the safety
         k = safety * rho / dt**2
     common = dict(slip_velocity=c.slip_velocity_fraction * speed, stiffness=k,
                   expected_pressure=expected_pressure(case)[0],
@@ -282,7 +284,7 @@ def _loads(case: Case, mesh: Mesh, fabrics, dt: float, jdtype, safety: float | N
     top = (ply_id == 1).astype(np.float64)
     bottom = (ply_id == case.n_plies).astype(np.float64)
     as_arr = lambda a: jnp.asarray(a, jdtype)  # noqa: E731
-    imp = dict(implicit_normal=bool(c.implicit_normal))
+    imp = dict(implicit_normal=bool(implicit_normal))
     face = dict(params=params_tool, offset=as_arr(h / 2), area=as_arr(area), **imp)
     punch = contact.ToolLoad(tool=tools_rig.punch, active=as_arr(top), **face)
     die = contact.ToolLoad(tool=tools_rig.die, active=as_arr(bottom), **face)
@@ -402,7 +404,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
                                        why=f"{numerics.why}; the step shortened from {dt_own:.3g} s to "
                                            f"{dt:.3g} s to share {every} steps per frame with a batch")
     every = every_own if every is None else int(every)
-    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, safety)
+    loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, safety, numerics.implicit_normal)
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
                                  fibre_mass_factor=fms, fibre_mass_momentum_term=case.fibre_mass_momentum_term)

@@ -161,7 +161,7 @@ def _step_choice(info, history) -> dict:
     p, why = expected_pressure(info.case)
     pen = history.get("max_penetration_m")
     return {"dt_governed_by": n.governed_by, "contact_safety": n.safety, "step_budget": n.budget,
-            "step_choice": n.why, "expected_pressure_Pa": p, "expected_pressure_choice": why,
+            "step_choice": n.why, "contact_implicit_normal": bool(n.implicit_normal), "expected_pressure_Pa": p, "expected_pressure_choice": why,
             "max_penetration_ply": float(np.max(pen)) / float(info.case.ply_thickness) if pen is not None and len(pen)
             else None, "penetration_limit_ply": MAX_PENETRATION}
 

@@ -30,6 +30,7 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     n = s["numerics"]
     assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
     assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
+    assert n["contact_implicit_normal"] is False and "normal forces backward" not in text  # FAST: explicit
     assert n["speed_choice"] == "given" and "punch 500 mm/s (given)" in text
     # the contact's expected pressure (given here) and the deepest penetration seen, within its limit
     assert n["expected_pressure_Pa"] == 1e5 and n["expected_pressure_choice"] == "given"

@@ -202,8 +202,9 @@ def report(result, written, out, stream=None):
             " with its momentum term" if n.get("fibre_mass_momentum_term") else "") + (
             f" (from step {n['fibre_mass_momentum_term_from_step']}: a chunk failed without it)"
             if n.get("fibre_mass_momentum_term_from_step") is not None else "")
+        normal = " (normal forces backward)" if n.get("contact_implicit_normal") else ""
         print(f"  numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']}), contact safety "
-              f"{safety}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
+              f"{safety}{normal}, fibre mass {mass}, punch {1e3 * n['punch_speed_m_per_s']:g} mm/s "
               f"({n.get('speed_choice', 'given')})", file=stream)
     for f in s.get("findings") or []:
         print(f"  {f['level']}: {f['text']}", file=stream)

@@ -196,20 +196,19 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
         s_ = max(AUTO_SAFETY, s_room)  # the room the shell leaves in the budget: the stiffest contact at no step cost
         return ContactNumerics(dt0, s_, "shell", budget(dt0, s_),
                                f"step {dt_safety:g} x the shell's stable step; contact safety {s_:.3g} "
-                               f"(penetration below {MAX_PENETRATION:g} h at {p_exp:.3g} Pa)", False)
+                               f"(penetration below {MAX_PENETRATION:g} h at {p_exp:.3g} Pa)", implicit)
     dt_ = 2.0 * STEP_BUDGET / math.sqrt(w_s2 + n_c * k_need / rho)
     s_ = k_need * dt_**2 / rho
     return ContactNumerics(dt_, s_, "contact", budget(dt_, s_),
                            f"a contact stiff enough for a penetration below {MAX_PENETRATION:g} h at "
                            f"{p_exp:.3g} Pa and stable with {n_c} contacts on a node needs a step of "
-                           f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}", False)
-
+                           f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}", implicit)
 
 
 def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float) -> ContactNumerics:
     """Choose the time step, the contact safety and how the contacts' normal forces are integrated.
 
-    ``contact.implicit_normal = "auto"`` (the presets' default): integrated backward
+    ``contact.implicit_normal = "auto"`` (the default): integrated backward
     (:mod:`jaxform.backward_normal`, the contact then takes nothing from the step) where the
     explicit contact would set the step (``governed_by == "contact"``: the shell would allow a
     longer one) and the backward normal holds, i.e. one ply under a holder at a fixed gap, with the

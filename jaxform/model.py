@@ -160,6 +160,9 @@ class State:
             (``M^-1``, or the fibre mass of :mod:`jaxform.fibre_mass`).
         u: (3, N) displacements from the mesh nodes (SoA), m: the integrated quantity (``x`` is
             ``X + u``; the shell is evaluated on ``u``, see :class:`~jaxform.shell.ShellRef`).
+        u_lost: (3, N) what rounding took from ``u``'s last increments, m (compensated summation,
+            :func:`jaxform.integrate.compensated_add`): increments of about 1e-6 m a step added to
+            displacements of up to 0.05 m lose 0.2 % each in float32, alike step after step.
     """
 
     x: Any
@@ -174,6 +177,7 @@ class State:
     scale_max: Any
     momentum: Any
     u: Any
+    u_lost: Any
 
 
 __all__ = ["Model", "State", "Energies", "Hold", "LinearDrive"]

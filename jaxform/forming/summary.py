@@ -7,6 +7,7 @@ import math
 import jax
 import numpy as np
 
+from jaxform.metrics.wrinkles import ring_max
 from jaxform.penalty import MAX_PENETRATION
 from jaxform.forming.case import to_dict
 from jaxform.forming.fields import ENERGY_KEYS, HISTORY_KEYS
@@ -104,12 +105,7 @@ def _off_image(v, image, faces):
     image node's one ring (the faces around it, ``faces`` (M, k)) spans, so that a feature one
     element off its image counts as matched (the mesh resolves no finer)."""
     vt = np.asarray(v, dtype=float).T  # (N, F)
-    hi, lo = np.full_like(vt, -np.inf), np.full_like(vt, np.inf)
-    fmax, fmin = vt[faces].max(axis=1), vt[faces].min(axis=1)  # (M, F)
-    for c in range(faces.shape[1]):
-        np.maximum.at(hi, faces[:, c], fmax)
-        np.minimum.at(lo, faces[:, c], fmin)
-    hi, lo = np.where(np.isfinite(hi), hi, vt), np.where(np.isfinite(lo), lo, vt)
+    hi, lo = np.asarray(ring_max(vt, faces)), -np.asarray(ring_max(-vt, faces))
     return np.max(np.maximum(np.maximum(vt - hi[image], lo[image] - vt), 0.0), axis=0)
 
 
@@ -161,7 +157,8 @@ def _step_choice(info, history) -> dict:
     p, why = expected_pressure(info.case)
     pen = history.get("max_penetration_m")
     return {"dt_governed_by": n.governed_by, "contact_safety": n.safety, "step_budget": n.budget,
-            "step_choice": n.why, "contact_implicit_normal": bool(n.implicit_normal), "expected_pressure_Pa": p, "expected_pressure_choice": why,
+            "step_choice": n.why, "contact_implicit_normal": bool(n.implicit_normal),
+            "expected_pressure_Pa": p, "expected_pressure_choice": why,
             "max_penetration_ply": float(np.max(pen)) / float(info.case.ply_thickness) if pen is not None and len(pen)
             else None, "penetration_limit_ply": MAX_PENETRATION}
 

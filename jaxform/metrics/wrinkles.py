@@ -38,6 +38,7 @@ __all__ = [
     "WRINKLE",
     "d_crit",
     "node_areas",
+    "ring_max",
     "classify_zones",
     "zone_areas",
     "wrinkle_radius",
@@ -89,15 +90,16 @@ def node_areas(nodes, faces):
     return jax.ops.segment_sum(share, f.reshape(-1), num_segments=x.shape[0])
 
 
-def _ring_max(values, faces, rings: int):
-    """Maximum of a nodal field over the faces around each node, repeated ``rings`` times."""
+def ring_max(values, faces, rings: int = 1):
+    """Maximum of a nodal field ``values`` (N, ...) over the faces (F, k) around each node (the node
+    itself included), repeated ``rings`` times."""
     f = jnp.asarray(faces)
     n = values.shape[0]
     for _ in range(rings):
         face_max = jnp.max(values[f], axis=1)
         values = jnp.maximum(
             values,
-            jax.ops.segment_max(jnp.repeat(face_max, f.shape[1]), f.reshape(-1), num_segments=n),
+            jax.ops.segment_max(jnp.repeat(face_max, f.shape[1], axis=0), f.reshape(-1), num_segments=n),
         )
     return values
 
@@ -119,7 +121,7 @@ def classify_zones(distance, kappa_max, d_critical, *, kappa_threshold=100.0, fa
     """
     k = jnp.asarray(kappa_max)
     if faces is not None and rings > 0:
-        k = _ring_max(k, faces, rings)
+        k = ring_max(k, faces, rings)
     defect = jnp.asarray(distance) > d_critical
     high = k >= kappa_threshold
     return jnp.where(defect, jnp.where(high, WRINKLE, BRIDGING), CONFORMING).astype(jnp.int32)

@@ -31,6 +31,9 @@ def test_run_writes_frames_summary_and_plots(tmp_out, capsys):
     assert n["dt_governed_by"] in ("shell", "contact") and 0 < n["step_budget"] <= 0.9 + 1e-9 and n["step_choice"]
     assert f"numerics: step {n['dt_s']:.3g} s x {n['n_steps']} (set by the {n['dt_governed_by']})" in text
     assert n["contact_implicit_normal"] is False and "normal forces backward" not in text  # FAST: explicit
+    # the warnings of its findings beside "complete" (500 mm/s: not quasi-static, so the kinetic energy's)
+    assert s["warnings"] == [f["kind"] for f in s["findings"] if f["level"] == "warning"] and "kinetic_energy" in s["warnings"]
+    assert "complete, with warnings (" in text
     assert n["speed_choice"] == "given" and "punch 500 mm/s (given)" in text
     # the contact's expected pressure (given here) and the deepest penetration seen, within its limit
     assert n["expected_pressure_Pa"] == 1e5 and n["expected_pressure_choice"] == "given"
@@ -369,9 +372,10 @@ def test_findings_say_what_speaks_against_a_result_and_the_report_prints_each():
     for part in ("up to 99 %", "27.5 / 1.0 mm (+y / -y)", "between 39.5 and 44.8 mm"):
         assert part in f["text"], part
     text = io.StringIO()
-    s["findings"] = findings(s)
+    s["findings"], s["warnings"] = findings(s), ["penetration"]
     report(SimpleNamespace(summary=s, complete=True), [], ".", stream=text)
     lines = text.getvalue().splitlines()
+    assert lines[0].startswith("c: complete, with warnings (penetration; below): not the converged answer")
     assert sum(ln.startswith("  warning: a node penetrated") for ln in lines) == 1
     assert sum(ln.startswith("  note: ") for ln in lines) == 2 and "x4 with the step cut to 1/4" in text.getvalue()
 

@@ -184,6 +184,8 @@ def report(result, written, out, stream=None):
     stream = stream or sys.stdout
     s = result.summary
     state = "complete" if result.complete else f"INCOMPLETE ({result.reason})"
+    if result.complete and s.get("warnings"):
+        state += f", with warnings ({', '.join(s['warnings'])}; below): not the converged answer as it stands"
     print(f"{s['case']}: {state}; {s['frames_written']} frames, wall time {s['wall_time_s']:.1f} s", file=stream)
     if s.get("max_shear_angle_deg") is not None:
         print(f"  max shear angle {s['max_shear_angle_deg']:.1f}°", end="", file=stream)

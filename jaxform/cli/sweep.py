@@ -35,6 +35,7 @@ import sys
 from jaxform.batching import cores
 from jaxform.cli.progress import Progress
 from jaxform.cli.run import OUTPUTS, point_data, save_plots
+from jaxform.forming.summary import warning_kinds
 
 SCALARS = ("max_shear_angle_deg", "draw_in_edge_mid_mm", "draw_in_corner_mm", "flange_wrinkles", "max_ke_ie")
 """The per-member scalars of ``sweep.csv`` and of the plots."""
@@ -127,7 +128,7 @@ def _row(i, name, vary, combo, result, process: int) -> dict:
     b = s.get("batch", {})
     row = {"member": i, "dir": name, **{k: v for (k, _), v in zip(vary, combo)}, "complete": bool(result.complete),
            "reason": result.reason or "", "max_shear_angle_deg": s.get("max_shear_angle_deg"),
-           "warnings": ";".join(f["kind"] for f in s.get("findings") or [] if f["level"] == "warning"),
+           "warnings": ";".join(warning_kinds(s.get("findings"))),
            "draw_in_edge_mid_mm": None if not di else 1e3 * di["edge_mid_m"],
            "draw_in_corner_mm": None if not di else 1e3 * di["corner_m"],
            "flange_wrinkles": s.get("flange_wrinkles"), "max_ke_ie": s.get("max_ke_ie"),

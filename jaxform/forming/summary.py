@@ -303,7 +303,13 @@ def summarize(result) -> dict:
     }
     s["half_turn_symmetry"] = half_turn_symmetry(result)
     s["findings"] = findings(s)
+    s["warnings"] = warning_kinds(s["findings"])  # beside "complete": a result in doubt does not read as success
     return s
+
+
+def warning_kinds(found) -> list[str]:
+    """The kinds of the findings ``found`` (:func:`findings`) that put the result in doubt (level "warning")."""
+    return [f["kind"] for f in found or [] if f["level"] == "warning"]
 
 
 QUASI_STATIC_LIMITS = {"shear_p95_deg": 1.0, "draw_in_edge_mid_rel": 0.02, "flange_wrinkles_diff": 0}
@@ -357,6 +363,6 @@ def quasi_static_check(result, half) -> dict:
     return out
 
 
-__all__ = ["draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
+__all__ = ["warning_kinds", "draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
            "QUASI_STATIC_KE_IE", "findings", "HALF_TURN_TOL", "half_turn_symmetry",
            "QUASI_STATIC_LIMITS", "quasi_static_check"]

@@ -15,6 +15,7 @@ import pathlib
 
 import numpy as np
 
+from jaxform.forming.summary import warning_kinds
 from jaxform.io.calibration_files import write_section_csv
 from jaxform.study import claims as C
 from jaxform.study.measures import load_run, measure_run, sections
@@ -174,7 +175,7 @@ def _run_table(runs, measures) -> list[str]:
         p1 = m.get("ply 1") or {}
         di = m.get("draw_in") or {}
         state = "yes" if m.get("complete") else f"no: {m.get('reason')}"
-        warn = ", ".join(f["kind"] for f in m.get("findings") or [] if f["level"] == "warning") or "–"
+        warn = ", ".join(warning_kinds(m.get("findings"))) or "–"
         lines.append(f"| {r.name} | {state} | {warn} | {_fmt(m.get('wall_time_s'), digits=4)} | {n.get('n_steps', '–')} | "
                      f"{_fmt(n.get('dt_s'))} | {_fmt(n.get('fibre_mass_scaling'))} | {_fmt(m.get('max_ke_ie'))} | "
                      f"{_fmt(m.get('max_shear_angle_deg'))} | {_fmt(di.get('edge_mid_m'), 1e3)} | "

@@ -137,6 +137,29 @@ def test_toml_file_roundtrip_and_unknown_names(tmp_path):
         cases.load(str(tmp_path / "broken.toml"))
 
 
+def test_the_shear_reading_is_a_case_key_that_reaches_the_shell(tmp_path):
+    """``fabric.shear_reading``: eq. A.14's tangent modulus (the default, left out of the TOML) or
+    ``"conjugate"`` (``F_norm`` itself the shear resultant); it round-trips through a file, an
+    unknown reading is refused naming the allowed ones, and the rig's shell reads the law so: its
+    resultant at 40 deg is the law's ``integral`` (a14) or its ``force`` (conjugate), 1.70 and 4.38 N/m."""
+    from jaxform.io.case_file import write_case
+    from jaxform.shell import shear_resultant
+
+    case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 25e-3)
+    conj = cases.apply_overrides(case, ["fabric.shear_reading=conjugate"])
+    assert case.fabric.shear_reading == "a14" and "shear_reading" not in cases.to_toml(case)
+    assert 'shear_reading = "conjugate"' in cases.to_toml(conj)
+    assert cases.load(str(write_case(conj, tmp_path / "c.toml"))) == conj
+    with pytest.raises(ValueError, match=r"'fabric\.shear_reading' = 'tangent': must be one of a14, conjugate"):
+        cases.apply_overrides(case, ["fabric.shear_reading=tangent"])
+    g, law = math.radians(40.0), materials.WOVEN_38616.shear
+    for c, want in ((case, law.integral(g)), (conj, law.force(g))):
+        shell = forming.build(c).model.shell
+        got = shear_resultant(law, g, shell.shear_reading)
+        assert float(got) == pytest.approx(float(want), rel=1e-6)
+    assert float(law.integral(g)) == pytest.approx(1.70, abs=0.01) and float(law.force(g)) == pytest.approx(4.38, abs=0.01)
+
+
 def test_overrides_are_named_in_the_description():
     c = cases.with_element_size(cases.load("case-a-woven-nlbm"), 4e-3)
     assert "2 mm elements" in c.description and "blank.element_size_mm=4.0" in c.description

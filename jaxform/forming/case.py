@@ -13,7 +13,8 @@ TOML layout (every key of the presets; ``jaxform.cases.to_toml(jaxform.cases.loa
     [fabric]   preset = "woven-38616" | "ncf-fcim359"; bending = "nlbm" | "lbm-init" | "lbm-41" |
                "lbm-inf" | "membrane"; optional: thickness_mm, areal_mass_gsm, friction_tool,
                friction_fabric, voce = {b_inf_Nm, m0_N, kappa0_per_m} (custom NLBM law, both
-               families), shear_poly_N_per_m = [c1, c2, ...] (custom odd polynomial)
+               families), shear_poly_N_per_m = [c1, c2, ...] (custom odd polynomial), shear_reading =
+               "a14" (default) | "conjugate" (how F_norm is read: jaxform.shell, README "Modelling choices")
     [plies]    orientations_deg = [0.0, ...]   (one angle per ply, ply 1 touches the punch)
     [blank]    size_mm, element_size_mm         (square blank centred on the punch axis)
     [tools]    punch_radius_mm, die_opening_radius_mm, die_fillet_mm, die_thickness_mm,
@@ -45,6 +46,7 @@ from typing import Any
 
 from jaxform import units
 from jaxform.penalty import stable_damping_ratio
+from jaxform.shell import SHEAR_READINGS
 from jaxform.forming.speed import quasi_static_speed
 
 BENDING_MODELS = ("nlbm", "lbm-init", "lbm-41", "lbm-inf", "membrane")
@@ -69,6 +71,7 @@ class FabricSpec:
     friction_fabric: float | None = None
     voce: tuple | None = None  # (b_inf N·m, m0 N, kappa0 1/m)
     shear_poly: tuple | None = None  # coefficients of g, g^2, ... in N/m
+    shear_reading: str = "a14"  # F_norm as eq. A.14's tangent modulus, or "conjugate": the resultant itself
 
 
 @dataclasses.dataclass(frozen=True)
@@ -175,6 +178,7 @@ SCHEMA: dict[str, dict[str, tuple]] = {
         "preset": ("str", True), "bending": ("str", True), "thickness_mm": ("float", False),
         "areal_mass_gsm": ("float", False), "friction_tool": ("float", False),
         "friction_fabric": ("float", False), "voce": ("table", False), "shear_poly_N_per_m": ("floats", False),
+        "shear_reading": ("str", False),
     },
     "plies": {"orientations_deg": ("floats", True)},
     "blank": {"size_mm": ("float", True), "element_size_mm": ("float", True)},
@@ -287,6 +291,9 @@ def _build(d) -> Case:
     for key in ("friction_tool", "friction_fabric"):
         if key in fab and fab[key] < 0:
             raise _err(f"fabric.{key}", fab[key], "must be >= 0")
+    if fab.get("shear_reading", "a14") not in SHEAR_READINGS:
+        raise _err("fabric.shear_reading", fab["shear_reading"], f"must be one of {', '.join(SHEAR_READINGS)} (how "
+                   "Table 1's F_norm is read: eq. A.14's tangent modulus, or the shear resultant itself)")
     voce = None
     if "voce" in fab:
         for k in fab["voce"]:
@@ -307,6 +314,7 @@ def _build(d) -> Case:
         areal_mass=units.gsm_to_kg_per_m2(fab["areal_mass_gsm"]) if "areal_mass_gsm" in fab else None,
         friction_tool=fab.get("friction_tool"), friction_fabric=fab.get("friction_fabric"),
         voce=voce, shear_poly=tuple(fab["shear_poly_N_per_m"]) if "shear_poly_N_per_m" in fab else None,
+        shear_reading=fab.get("shear_reading", "a14"),
     )
     if fabric.bending == "lbm-41" and PRESETS[fabric.preset].measured_b41_5 is None:
         raise _err("fabric.bending", "lbm-41", f"preset {fabric.preset!r} has no measured B_41.5")
@@ -460,19 +468,13 @@ def _mm(x):
 def to_dict(case: Case) -> dict:
     """The TOML-shaped dict (mm units) of a case; ``from_dict(to_dict(c)) == c``."""
     f = case.fabric
-    fab: dict[str, Any] = {"preset": f.preset, "bending": f.bending}
-    if f.thickness is not None:
-        fab["thickness_mm"] = _mm(f.thickness)
-    if f.areal_mass is not None:
-        fab["areal_mass_gsm"] = float(f"{units.kg_per_m2_to_gsm(f.areal_mass):.12g}")
-    if f.friction_tool is not None:
-        fab["friction_tool"] = f.friction_tool
-    if f.friction_fabric is not None:
-        fab["friction_fabric"] = f.friction_fabric
-    if f.voce is not None:
-        fab["voce"] = dict(zip(_VOCE_KEYS, f.voce))
-    if f.shear_poly is not None:
-        fab["shear_poly_N_per_m"] = list(f.shear_poly)
+    optional = {"thickness_mm": None if f.thickness is None else _mm(f.thickness),
+                "areal_mass_gsm": None if f.areal_mass is None else float(f"{units.kg_per_m2_to_gsm(f.areal_mass):.12g}"),
+                "friction_tool": f.friction_tool, "friction_fabric": f.friction_fabric,
+                "voce": None if f.voce is None else dict(zip(_VOCE_KEYS, f.voce)),
+                "shear_poly_N_per_m": None if f.shear_poly is None else list(f.shear_poly),
+                "shear_reading": None if f.shear_reading == "a14" else f.shear_reading}  # the default left out
+    fab = {"preset": f.preset, "bending": f.bending, **{k: v for k, v in optional.items() if v is not None}}
     t = case.tools
     tools_d = {
         "punch_radius_mm": _mm(t.punch_radius), "die_opening_radius_mm": _mm(t.die_opening_radius),
@@ -484,13 +486,8 @@ def to_dict(case: Case) -> dict:
         tools_d.update(punch_mesh=t.punch_mesh, punch_mesh_units=t.punch_mesh_units,
                        punch_mesh_cell_mm=_mm(t.punch_mesh_cell))
     h = case.holder
-    holder = {"mode": h.mode}
-    if h.gap is not None:
-        holder["gap_mm"] = _mm(h.gap)
-    if h.force is not None:
-        holder["force_N"] = h.force
-    if h.mass is not None:
-        holder["mass_kg"] = h.mass
+    holder = {"mode": h.mode, **{k: v for k, v in (("gap_mm", None if h.gap is None else _mm(h.gap)),
+                                                   ("force_N", h.force), ("mass_kg", h.mass)) if v is not None}}
     p, c = case.process, case.contact
     numerics = {"dtype": case.dtype, "mass_scaling": case.mass_scaling,
                 "fibre_mass_scaling": "auto" if case.fibre_mass_scaling is None else case.fibre_mass_scaling,

@@ -379,7 +379,7 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
 
     mesh = build_mesh(case)
     fabrics = ply_fabrics(case, fabric)
-    shell = Shell.build(mesh, fabrics)
+    shell = Shell.build(mesh, fabrics, shear_reading=case.fabric.shear_reading)
     ms = float(case.mass_scaling)
     fms = (auto_fibre_mass(shell, ms, momentum_term=case.fibre_mass_momentum_term) if case.fibre_mass_scaling is None
            else float(case.fibre_mass_scaling))

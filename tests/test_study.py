@@ -141,6 +141,11 @@ def test_claim_verdicts_on_constructed_measures():
     assert C.claim_1(m)["verdict"] == "partly"  # off the diagonals; dome and symmetry fine
     c1 = C.claim_1(dict([_measure("case-a-woven-nlbm", lobes)]))  # the lobes alone: nothing inside a quadrant
     assert c1["verdict"] == "partly" and "so no primary on any diagonal, and 4 on the x/y axes" in c1["why"]
+    assert c1["measured"]["shear_reading"] == "a14" and "fabric.shear_reading = \"conjugate\"" in c1["why"]
+    conj = dict([_measure("case-a-woven-nlbm", lobes)])  # the other reading: the pointer to it is not repeated
+    conj["case-a-woven-nlbm"]["shear_reading"] = "conjugate"
+    assert "fabric.shear_reading" not in C.claim_1(conj)["why"]
+    assert "fabric.shear_reading" not in C.claim_1(dict([_measure("case-a-woven-nlbm", diag)]))["why"]
     assert C.claim_1({})["verdict"] == "not measurable"
     # claim 3: counts fall as the stiffness rises (B_inf -> B_41.5 -> B_init)
     dev = {"flange_deviation_m": {"mean": 1e-3}}

@@ -156,6 +156,11 @@ def claim_1(m):
                 f"r {1e3 * min(w['r_inner_m'] for w in on_axis):.0f}-{1e3 * max(w['r_outer_m'] for w in on_axis):.0f} mm: "
                 "the flange lifting at the mid-sides under the open holder, which the claim does not mention)")
     why += f"; dome deviation up to {1e3 * dome:.2f} mm; mirror error {100 * sym:.1f} %"
+    reading = measured["shear_reading"] = m[name].get("shear_reading", "a14")
+    if len(diag) < 4 and reading == "a14":  # the cause found (README, Modelling choices: the shear reading)
+        why += (". The shear law was read as eq. A.14 (resultant int F_norm dgamma, 1.7 N/m at 40 deg); read as "
+                "the frame force itself (fabric.shear_reading = \"conjugate\", 4.4 N/m) the same case formed one "
+                "wrinkle along each diagonal at 8 and 4 mm (benchmarks/results/claim1-geometry-20261207)")
     return _claim(1, [name], measured, _verdict(checks), why)
 
 

@@ -256,6 +256,7 @@ def measure_run(run: RunData, *, strokes=()) -> tuple[dict, dict]:
            "wall_time_s": s.get("wall_time_s"), "max_ke_ie": s.get("max_ke_ie"), "findings": s.get("findings") or [],
            "max_shear_angle_deg": s.get("max_shear_angle_deg"), "draw_in": s.get("draw_in"),
            "numerics": s.get("numerics"), "element_size_m": float(run.case.element_size),
+           "shear_reading": run.case.fabric.shear_reading,
            "frames": len(run.frames)}
     arrays = {}
     last = run.frame(-1)

@@ -8,7 +8,8 @@ frame.csv: ``gamma_deg`` (or ``gamma_rad``) with ``f_norm_N_per_m``; or raw fram
 ``F / (2 L cos(pi/4 - gamma/2))``. The polynomial (odd, no constant term) is constrained to be
 non-decreasing on the fitted range; ``--form ncf`` adds the positive-only stitch term (the yarn
 polynomial is the constrained part). The TOML holds ``[fabric] shear_poly_N_per_m`` (the key a
-forming case reads) and a ``[shear_fit]`` record. ``--check`` simulates the picture frame with
+forming case reads) with ``shear_reading = "conjugate"`` (the measured frame force is the formed
+fabric's shear resultant; README, "Modelling choices") and a ``[shear_fit]`` record. ``--check`` simulates the picture frame with
 the fitted law (the shell's picture-frame rig, ``jaxform.frame_tests``).
 
 Input is checked before anything is fitted, and refused (``fit_shear.py: error: ...``, exit 2,

@@ -76,6 +76,14 @@ def test_toml_round_trip(tmp_path):
     path = cf.write_shear_toml(tmp_path / "s.toml", fit.as_dict())
     law = cf.read_shear_toml(path)
     np.testing.assert_allclose(np.asarray(law.force(g)), np.asarray(fit.law.force(g)), rtol=1e-12)
+    # its [fabric] table, merged into a case, gives the formed fabric the measured frame force as its resultant
+    import tomllib
+
+    from jaxform import cases
+
+    fab = tomllib.loads(path.read_text())["fabric"]
+    case = cases.apply_overrides(cases.load("case-a-woven-nlbm"), [f"fabric.{k}={json.dumps(v)}" for k, v in fab.items()])
+    assert case.fabric.shear_reading == "conjugate" and case.fabric.shear_poly == pytest.approx(fit.coeffs)
     with pytest.raises(FileExistsError):
         cf.write_shear_toml(path, fit.as_dict())
 

@@ -309,7 +309,11 @@ def shear_toml(fit_dict: dict) -> str:
     """TOML text of a fitted shear law (N/m, rad).
 
     ``[fabric] shear_poly_N_per_m = [...]`` is the key a forming case (:mod:`jaxform.cases`) reads
-    for a custom odd polynomial: merge that line into a case file. ``[shear_fit]`` records the fit
+    for a custom odd polynomial, with ``shear_reading = "conjugate"``: the fitted ``F_norm`` is the
+    frame force the test measured, so the formed fabric takes it as its shear resultant and a
+    simulated frame gives the measured force back (under the default reading, eq. A.14's tangent
+    modulus, the resultant would be its integral: 2.6-3.6x softer over 30-55 deg for the woven law;
+    README, "Modelling choices"). Merge those lines into a case file. ``[shear_fit]`` records the fit
     (kind, range, rmse and, for the NCF form, the stitch knots, which forming cases cannot take
     yet); :func:`read_shear_toml` loads the full law back from it.
     """
@@ -320,7 +324,9 @@ def shear_toml(fit_dict: dict) -> str:
     lines = ["# Shear law fitted by calibration/fit_shear.py (normalised force N/m, shear angle rad)"]
     if not ok:
         lines += ["# NOT A VALID FIT, do not use it in a forming case: " + str(fit_dict.get("reason", ""))]
-    lines += ["[fabric]", f"shear_poly_N_per_m = {arr(fit_dict['coeffs_N_per_m'])}", "", "[shear_fit]",
+    lines += ["[fabric]", f"shear_poly_N_per_m = {arr(fit_dict['coeffs_N_per_m'])}",
+              "# the measured frame force is the shear resultant (\"a14\", the default, would make it its integral)",
+              'shear_reading = "conjugate"', "", "[shear_fit]",
              f'kind = "{fit_dict["kind"]}"']
     if fit_dict["kind"] == "ncf":
         lines += [f"stitch_gamma_knots_rad = {arr(fit_dict['stitch_gamma_knots_rad'])}",

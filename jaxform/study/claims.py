@@ -160,7 +160,7 @@ def claim_1(m):
     if len(diag) < 4 and reading == "a14":  # the cause found (README, Modelling choices: the shear reading)
         why += (". The shear law was read as eq. A.14 (resultant int F_norm dgamma, 1.7 N/m at 40 deg); read as "
                 "the frame force itself (fabric.shear_reading = \"conjugate\", 4.4 N/m) the same case formed one "
-                "wrinkle along each diagonal at 8 and 4 mm (benchmarks/results/claim1-geometry-20261207)")
+                "wrinkle along each diagonal at 8, 4 and 2 mm (benchmarks/results/claim1-geometry-20261207)")
     return _claim(1, [name], measured, _verdict(checks), why)
 
 

@@ -31,7 +31,7 @@ construction as Runge-Kutta-Chebyshev stability polynomials), normalised to ``q(
 * ``y q(y) <= peak(n) / n^2`` (``peak`` about 1.008): the fibre-stretch frequencies
   ``omega^2 = X y q(y)`` are bounded by ``X peak / n^2``. :func:`fibre_mass` takes the smallest
   ``n`` with ``sqrt(X peak(n)) / n <= omega_m / s`` (``omega_m`` the membrane estimate of
-  :func:`jaxform.shell.stable_time_step`), so that the membrane limit grows by the factor ``s``;
+  :func:`jaxform.spectrum.stable_time_step`), so that the membrane limit grows by the factor ``s``;
 * long fibre-stretch waves (small ``y``) get the mass ``M / q ~ M (1 + (n^2 - 1) y / 3)``:
   the added inertia is smallest where the waves are slow anyway.
 
@@ -69,11 +69,8 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.mesh import assemble_corners
-from jaxform.shell import Shell, _dot, _edges, _fibres_soa, _stretch, membrane_frequency
-
-BOUND_MARGIN = 1e-3  # spectral_bound's eigenvalue raised by this fraction (Lanczos at tol 1e-4 read the 1 mm woven
-#                      blank's 2.7e-6 below its value at tol 1e-10, which the dense solver agrees with on small meshes)
-DENSE_NODES = 500  # spectral_bound: a dense eigensolver up to this many nodes, Lanczos above
+from jaxform.shell import Shell, _dot, _edges, _fibres_soa, _stretch
+from jaxform.spectrum import membrane_frequency, spectral_bound, tension_stiffness
 ETA = 0.05  # Chebyshev damping: keeps q > 0 (undamped, q has zeros: modes of infinite mass)
 
 
@@ -134,63 +131,6 @@ def peak(n: int) -> float:
     return 1.001 * n**2 * float(np.max(y * _q(y, n, theta, a, b))) / q0
 
 
-def _tension_stiffness(fab):
-    """``(E h)_f`` (2,) of a ply's two fibre families, N/m (host, float64)."""
-    return np.broadcast_to(np.asarray(fab.fibre_modulus, np.float64) * float(np.asarray(fab.thickness)), (2,))
-
-
-def spectral_bound(shell: Shell, mass_scale=1.0) -> list:
-    """Per ply, an upper bound ``X`` of the eigenvalues of ``M^-1 K_t``, 1/s² (host, float64), that
-    holds whatever the current fibre directions.
-
-    With ``d_f = sum_a c_a v_a`` (``c`` the triangle's corner coefficients of ``b_f``), ``v^T K_t v
-    = sum A (E h)_f (u_f . d_f)^2 <= sum A (E h)_f |d_f|^2`` for unit ``u_f`` (Cauchy-Schwarz), which
-    is ``sum_k v_k^T L v_k`` over the three components, ``L = sum A (E h)_f c c^T`` the scalar
-    operator of the reference mesh. So the largest eigenvalue of ``M^-1/2 L M^-1/2`` bounds
-    ``M^-1 K_t`` in every deformed state (fibre strains enter only through the small geometric
-    stiffness, left out of ``K_t``). It is reached where both families run in one direction (the
-    limit of shear: ``v`` the top eigenvector of ``L`` along it); sheared 50 degrees, ``M^-1 K_t``
-    reaches 0.885 of it (tests/test_fibre_mass.py). It is found by Lanczos
-    (``scipy.sparse.linalg.eigsh``; dense up to :data:`DENSE_NODES` nodes) and raised by
-    :data:`BOUND_MARGIN` (Lanczos converges from below).
-    Gershgorin's bound of the same operator (its largest absolute row sum) is the fallback where
-    Lanczos does not converge: 1.19x this on Case A, woven and NCF alike. The block Gershgorin bound
-    used before (every triangle's blocks summed in absolute value) was 1.19x on the woven and 1.39x
-    on the NCF, and gave the woven's factor-12 mass degree 14 where this gives 13 (``n ~ sqrt(X)``).
-    """
-    import scipy.sparse as sp
-    import scipy.sparse.linalg as sla
-
-    mesh = shell.mesh
-    m = np.asarray(shell.node_masses(mass_scale), np.float64)
-    s = 1.0 / np.sqrt(m)
-    tris = np.asarray(mesh.tris)
-    coef = np.asarray(shell.ref.tri_coef, np.float64)
-    area = np.asarray(shell.ref.tri_area, np.float64)
-    out = []
-    for (t0, t1), fab in zip(mesh.ply_tris, shell.fabrics):
-        eh = _tension_stiffness(fab)
-        nodes, t = np.unique(tris[t0:t1], return_inverse=True)  # the ply's own nodes
-        t, sn = t.reshape(-1, 3), s[nodes]
-        rows, cols, vals = [], [], []
-        for f in range(2):
-            c = np.stack([-(coef[t0:t1, f, 0] + coef[t0:t1, f, 1]), coef[t0:t1, f, 0], coef[t0:t1, f, 1]], 1)
-            for i in range(3):
-                for j in range(3):
-                    rows.append(t[:, i])
-                    cols.append(t[:, j])
-                    vals.append(area[t0:t1] * eh[f] * c[:, i] * c[:, j] * sn[t[:, i]] * sn[t[:, j]])
-        a = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))), shape=(len(nodes),) * 2)
-        gershgorin = float(np.max(np.asarray(abs(a).sum(axis=1)).ravel()))
-        try:
-            lam = (float(np.linalg.eigvalsh(a.toarray())[-1]) if len(nodes) <= DENSE_NODES else
-                   float(sla.eigsh(a, k=1, which="LA", tol=1e-4, return_eigenvectors=False)[0]))
-        except sla.ArpackNoConvergence:
-            lam = gershgorin
-        out.append(min(gershgorin, lam * (1.0 + BOUND_MARGIN)))
-    return out
-
-
 def degree_for(factor: float, bound: float, omega_m: float) -> int:
     """The smallest Chebyshev degree ``n`` with ``sqrt(bound peak(n)) / n <= omega_m / factor``."""
     n = max(1, math.ceil(factor * math.sqrt(bound) / omega_m) - 1)
@@ -215,7 +155,7 @@ def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, dtype=jnp.float32
     area = np.asarray(shell.ref.tri_area, np.float64)
     w = np.zeros((2, len(area)))
     for (t0, t1), fab, x in zip(shell.mesh.ply_tris, shell.fabrics, bounds):
-        eh = _tension_stiffness(fab)
+        eh = tension_stiffness(fab)
         w[:, t0:t1] = area[None, t0:t1] * eh[:, None] / x
     return FibreMass(weight=jnp.asarray(w, dtype), degree=n, factor=factor, geometric=bool(momentum_term))
 
@@ -281,5 +221,5 @@ def geometric_force(xs, ps, mass, free, fm: FibreMass, shell: Shell):
     return -jax.grad(kinetic)(xs)
 
 
-__all__ = ["FibreMass", "geometric_force", "fibre_mass", "spectral_bound", "BOUND_MARGIN", "DENSE_NODES", "degree_for",
+__all__ = ["FibreMass", "geometric_force", "fibre_mass", "degree_for",
            "chebyshev", "peak", "fibre_units", "stretch_rates", "stiffness_times", "inverse_mass_times"]

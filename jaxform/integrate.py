@@ -47,7 +47,8 @@ import numpy as np
 from jaxform import fibre_mass as _fm
 from jaxform._pytree import pytree_dataclass
 from jaxform.model import Energies, Hold, Model, State
-from jaxform.shell import Shell, forces_and_energy_sym, stable_time_step
+from jaxform.shell import Shell, forces_and_energy_sym
+from jaxform.spectrum import stable_time_step
 
 
 class SimulationError(RuntimeError):
@@ -93,7 +94,7 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
                dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_momentum_term: bool = False) -> Model:
     """Build a :class:`Model` on the host.
 
-    ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.shell.stable_time_step`);
+    ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.spectrum.stable_time_step`);
     a user ``dt`` above the limit is kept but warned about. ``mass_scale`` multiplies all masses
     (raising the stable step by its square root). ``fibre_mass_factor`` ``s`` > 1 adds inertia to
     fibre stretching only (:mod:`jaxform.fibre_mass`; the membrane limit grows by ``s``). ``fixed``

@@ -446,54 +446,6 @@ def forces(x, shell: Shell):
     return forces_and_energy(x, shell)[0]
 
 
-def _ply_frequencies(shell: Shell, mass_scale=1.0):
-    """Per ply ``(omega_m, omega_b)``, rad/s: the membrane and bending estimates of
-    :func:`stable_time_step` (host)."""
-    from jaxform.materials import max_stiffness
-
-    mesh = shell.mesh
-    nodes = np.asarray(mesh.nodes)
-    tris = np.asarray(mesh.tris)
-    out = []
-    for (t0, t1), fab in zip(mesh.ply_tris, shell.fabrics):
-        p = nodes[tris[t0:t1]]
-        edges = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 1], p[:, 0] - p[:, 2]], 1)
-        el = np.linalg.norm(edges, axis=-1)
-        area = np.asarray(shell.ref.tri_area[t0:t1])
-        alt = (2 * area / el.max(axis=1)).min()
-        rho = float(np.max(np.asarray(fab.areal_mass))) * float(np.min(np.asarray(mass_scale)))
-        eh = float(np.max(np.asarray(fab.fibre_modulus))) * float(np.max(np.asarray(fab.thickness)))
-        wm = 2.0 * np.sqrt(eh / rho) / alt
-        wb = 0.0
-        if fab.bending is not None:
-            b = max(float(np.max(np.asarray(max_stiffness(law)))) for law in fab.bending)
-            wb = 8.0 * np.sqrt(b / rho) / alt**2
-        out.append((wm, wb))
-    return out
-
-
-def membrane_frequency(shell: Shell, mass_scale=1.0) -> list:
-    """Per ply, the highest fibre-stretch frequency estimate ``omega_m = 2 c / l``, rad/s (host)."""
-    return [wm for wm, _ in _ply_frequencies(shell, mass_scale)]
-
-
-def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_mass_factor: float = 1.0) -> float:
-    """Largest stable central-difference time step estimated from the wave speeds, s (host).
-
-    Membrane: ``omega_m = 2 c / l`` with ``c = sqrt(E h / rho_A)`` and ``l`` the smallest triangle
-    altitude; bending: ``omega_b = 8 sqrt(B / rho_A) / l^2`` with ``B`` the largest tangent bending
-    stiffness of the laws (the flexural dispersion ``omega = sqrt(B/rho_A) k^2`` at the mesh's
-    shortest waves in two directions); ``dt = safety * 2 / sqrt(omega_m^2 + omega_b^2)``. The test
-    suite checks this against the largest eigenfrequency of the assembled shell (power iteration).
-    ``fibre_mass_factor`` ``s``: fibre-selective mass scaling (:mod:`jaxform.fibre_mass`) divides
-    ``omega_m`` by ``s``.
-    """
-    dt = np.inf
-    for wm, wb in _ply_frequencies(shell, mass_scale):
-        dt = min(dt, safety * 2.0 / np.sqrt((wm / fibre_mass_factor) ** 2 + wb**2))
-    return float(dt)
-
-
 __all__ = [
     "Shell",
     "ShellRef",
@@ -507,7 +459,5 @@ __all__ = [
     "shear_angle",
     "fibre_curvatures",
     "shear_resultant",
-    "stable_time_step",
-    "membrane_frequency",
     "SHEAR_READINGS",
 ]

@@ -153,7 +153,8 @@ def test_quasi_static_halving_the_punch_speed_changes_little():
 
 def _numerics(name, size_mm, *keys):
     from jaxform.forming import numerics, rig
-    from jaxform.shell import Shell, stable_time_step
+    from jaxform.shell import Shell
+    from jaxform.spectrum import stable_time_step
 
     case = cases.apply_overrides(cases.with_element_size(cases.load(name), size_mm * 1e-3), list(keys))
     fabs = rig.ply_fabrics(case)

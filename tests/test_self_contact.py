@@ -366,7 +366,8 @@ def _squeeze_strip(self_contact, *, length=0.06, width=0.004, n_len=60, gap_h=6.
     from jaxform.materials.bending import LinearBending
     from jaxform.mesh import Mesh
     from jaxform.model import LinearDrive
-    from jaxform.shell import Shell, stable_time_step
+    from jaxform.shell import Shell
+    from jaxform.spectrum import stable_time_step
 
     law = LinearBending(bending)
     fab = materials.preset("woven-38616").replace(bending=(law, law))

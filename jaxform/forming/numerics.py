@@ -16,7 +16,8 @@ import numpy as np
 from jaxform.penalty import EXPECTED_PRESSURE, MAX_PENETRATION
 from jaxform.forming.case import Case
 from jaxform.forming.speed import along_edges
-from jaxform.shell import Shell, _ply_frequencies
+from jaxform.shell import Shell
+from jaxform.spectrum import ply_frequencies
 
 FIBRE_MASS_MAX = 12.0
 """The largest automatic fibre-mass factor for plies whose fibres run along the square blank's
@@ -43,12 +44,13 @@ def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False) -
     less than 25% of step), rounded up to a whole number, at most :data:`FIBRE_MASS_MAX`
     (:data:`FIBRE_MASS_MAX_OFF_AXIS` when a ply's fibres run off the blank's edges); 1 where the
     membrane does not set the step (``omega_m / omega_b`` grows with the element size). Woven
-    Case A: 12 at 8, 4 and 2 mm (88, 45 and 23 wanted); NCF (+-45 deg): 3 (22, 12 and 5.8 wanted
-    at 8, 4 and 2 mm); membrane only: 12. With the fibre mass's momentum term (``momentum_term``,
+    Case A: 12 at 8, 4 and 2 mm (285, 147 and 74 wanted with the bending eigenvalue of
+    :func:`jaxform.spectrum.ply_frequencies`); NCF (+-45 deg): 3 (72, 37 and 18 wanted at 8, 4
+    and 2 mm); membrane only: 12. With the fibre mass's momentum term (``momentum_term``,
     :func:`jaxform.fibre_mass.geometric_force`) the off-axis cap does not apply: NCF Case A ran to
     completion with 12 at 4 mm (183 s, as with 3) and 2 mm (2449 s; 6 without the term: 1385 s)."""
     need, cap = 1.0, FIBRE_MASS_MAX
-    for (wm, wb), fab in zip(_ply_frequencies(shell, mass_scale), shell.fabrics):
+    for (wm, wb), fab in zip(ply_frequencies(shell, mass_scale), shell.fabrics):
         need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
         if not along_edges(fab.fibre_angles) and not momentum_term:
             cap = min(cap, FIBRE_MASS_MAX_OFF_AXIS)

@@ -44,7 +44,8 @@ from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNume
                                       contact_numerics, expected_pressure)
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
-from jaxform.shell import Shell, stable_time_step
+from jaxform.shell import Shell
+from jaxform.spectrum import stable_time_step
 
 PUNCH, DIE, HOLDER = 0, 1, 2
 """Indices of the three tools in ``model.loads``."""

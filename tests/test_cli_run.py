@@ -340,10 +340,10 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
     assert [f["kind"] for f in result.summary["findings"] if f["level"] == "warning"] == ["kinetic_energy"]
     assert json.loads((tmp_out / "summary.json").read_text())["findings"] == result.summary["findings"]
     # a symmetric case, meshed symmetrically: kept to float32 rounding. Its shear is tiny (0.41 deg at
-    # most), so the shear map's error relative to its largest value is rounding's tens of ulps of an
-    # angle near 90 deg: 6.4e-4 and 1.22e-3 with this suite's host (x64; 8.5e-4 and 3.2e-4 without) for
-    # a contact stiffness differing in the 12th digit (the step's rounding to the frames, 2026-12-07);
-    # the summary's finding fires at 0.2
+    # most), and the shear map's error is over max(largest, 1 deg): 6.4e-4 and 1.22e-3 (2e-5 rad, tens
+    # of float32 ulps of an angle near 90 deg) with this suite's host (x64; 8.5e-4 and 3.2e-4 without)
+    # for a contact stiffness differing in the 12th digit (the step's rounding to the frames,
+    # 2026-12-07); the summary's finding fires at 0.2
     sym = result.summary["half_turn_symmetry"]
     assert sym["deviation"] < 1e-3 and sym["shear_angle"] < 5e-3 and sym["broken_between_punch_m"] is None, sym
     for fig in (fplots.shear_map(result), fplots.deviation_map(result)):

@@ -383,6 +383,29 @@ def test_a_contact_the_pressures_sink_into_stiffens_and_the_run_goes_on_with_hal
     assert "the contact was stiffened to x4 with the step cut to 1/2" in _report(auto)
 
 
+def test_a_contact_integrated_backward_stiffens_without_cutting_the_step():
+    """Where the normal forces are integrated backward (stable at any stiffness) the driver stiffens
+    a contact the pressures sink into and keeps the step; the explicit contact halves it. Case A on
+    25 mm elements, 6 mm of stroke, a given contact safety of 2e-4 and 1 Pa expected (soft: the blank
+    settling onto the tools sinks 0.3 of the ply into them)."""
+    from jaxform.forming import driver, numerics
+
+    runs = {}
+    for implicit in ("true", "false"):
+        case = _coarse("case-a-woven-nlbm", process__stroke_mm=6, process__frames=3, contact__safety=2e-4,
+                       contact__expected_pressure_Pa=1, contact__implicit_normal=implicit)
+        runs[implicit] = forming.run(forming.build(case), catch=True)
+    backward, explicit = runs["true"], runs["false"]
+    assert backward.complete and explicit.complete, (backward.reason, explicit.reason)
+    assert backward.info.numerics.implicit_normal and not explicit.info.numerics.implicit_normal
+    for r, cut in ((backward, 1), (explicit, 2)):
+        c = r.step_cuts[0]
+        assert (c["cut"], c["contact_stiffness"]) == (cut, numerics.CONTACT_STIFFEN) and driver.penetrated(c["cause"])
+        assert r.summary["numerics"]["smallest_dt_s"] == pytest.approx(r.info.dt / cut)
+    assert "stiffened to x4 (the step kept: the normal forces are integrated backward)" in _report(backward)
+    assert "stiffened to x4 with the step cut to 1/2" in _report(explicit)
+
+
 @pytest.mark.slow
 def test_the_stiffened_contact_s_draw_in_does_not_follow_the_step_and_a_batch_member_stiffens_alone():
     """The rest of the test above (slow: two more forming programs, about 30 s of the default run): the

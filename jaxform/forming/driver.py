@@ -15,6 +15,7 @@ penetrated too deep an automatic contact, with the contact stiffened as well.
 from __future__ import annotations
 
 import dataclasses
+import math
 import time
 from typing import Any, Callable
 
@@ -237,6 +238,7 @@ class Standing:
     switched: dict | None = None
     may_cut: bool = True
     may_stiffen: bool = False
+    backward_normal: bool = False
     cuts: list = dataclasses.field(default_factory=list)
     applied: float = 1.0
     armed: bool = True
@@ -245,7 +247,8 @@ class Standing:
     def of(cls, model, state, info: RunInfo) -> "Standing":
         """A run's start: what the driver may change follows from what the user gave (a step is
         never cut, nor a penalty stiffness raised, where the user gave it)."""
-        return cls(model, state, may_cut=may_cut_step(info), may_stiffen=may_stiffen_contact(info))
+        return cls(model, state, may_cut=may_cut_step(info), may_stiffen=may_stiffen_contact(info),
+                   backward_normal=bool(getattr(getattr(info, "numerics", None), "implicit_normal", False)))
 
     @property
     def cut(self) -> int:
@@ -268,7 +271,10 @@ class Standing:
 
     @property
     def can_stiffen(self) -> bool:
-        """Whether :meth:`recover` may still stiffen the contact (and halve the step with it)."""
+        """Whether :meth:`recover` may still stiffen the contact (and halve the step with it, where
+        the contact is explicit): as often as the step may be halved (:data:`MAX_STEP_CUT`)."""
+        if self.backward_normal:
+            return self.may_stiffen and self.stiffness < CONTACT_STIFFEN ** math.log2(MAX_STEP_CUT) * (1.0 - 1e-9)
         return self.may_stiffen and self.cut < MAX_STEP_CUT
 
     def stiffen_above(self, rec: "Recorder") -> float:
@@ -306,7 +312,9 @@ class Standing:
         die (:func:`~jaxform.forming.health.drawn_in`: the forming failed). A penetration (:func:`penetrated`):
         half the step, and the contact on its way to :data:`~jaxform.forming.numerics.CONTACT_STIFFEN`
         times as stiff (:meth:`ramp`; at once beyond half the ply), an automatic contact only: a
-        step cut alone never helps there. Else: the momentum
+        step cut alone never helps there; where the contacts' normal forces are integrated
+        backward (``numerics.implicit_normal``: stable at any stiffness and damping,
+        :mod:`jaxform.backward_normal`) the step stays. Else: the momentum
         term (:meth:`switch`), else half the step (down to 1/:data:`MAX_STEP_CUT`, an automatic
         step only)."""
         if drawn_in(cause):
@@ -314,7 +322,7 @@ class Standing:
         if penetrated(cause):
             if not self.can_stiffen:
                 return False
-            self.cuts.append({**self._where(rec, cause), "cut": 2 * self.cut,
+            self.cuts.append({**self._where(rec, cause), "cut": self.cut if self.backward_normal else 2 * self.cut,
                               "contact_stiffness": CONTACT_STIFFEN * self.stiffness})
             self.armed = False
             if DEEPER not in cause:  # beyond half the ply: at once (the chunk failed; ramp() otherwise)
@@ -377,7 +385,8 @@ def run(rig: Rig, *, on_frame: Callable | None = None, on_progress: Callable | N
     the rest of the run too (``step_cuts`` of the result, ``numerics.step_cuts`` of the summary).
     A node deeper in a tool or ply than :data:`~jaxform.forming.numerics.STIFFEN_PENETRATION` of
     the ply at a chunk's end, and deeper than at its start, where the contact's stiffness was
-    chosen automatically (:func:`may_stiffen_contact`): the chunk again with half the step, and
+    chosen automatically (:func:`may_stiffen_contact`): the chunk again with half the step (the
+    step stays where the normal forces are integrated backward), and
     the contact :data:`~jaxform.forming.numerics.CONTACT_STIFFEN` times as stiff over the next 8
     chunks (:meth:`Standing.ramp`; at once beyond half the ply), not again before the
     penetration has healed (the automatic contact is chosen for an expected pressure; the fabric

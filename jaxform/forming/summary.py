@@ -226,18 +226,21 @@ def findings(s: dict) -> list[dict]:
             f"{lo:.1f} and {hi:.1f} mm of punch travel: from there the buckling chose among patterns the case does not "
             "tell apart (where the wrinkles lie, or a snap on one side), so this is one of the results the run could "
             "have given, not the converged answer (--verify-quasi-static compares another).")})
-    k_before = 1.0
-    for c in n.get("step_cuts") or []:  # at most three: a cut stays
+    k_before, cut_before = 1.0, 1
+    for c in n.get("step_cuts") or []:  # a few: each cut and each stiffening stays
         where = f"from step {c['step']} (t = {c['t_s']:.4g} s, punch {1e3 * c['punch_displacement_m']:.3g} mm: {c['cause']})"
         if c["contact_stiffness"] > k_before:
             out.append({"kind": "contact_stiffened", "level": "note", "text": (
-                f"the contact was stiffened to x{c['contact_stiffness']:g} with the step cut to 1/{c['cut']} {where}: "
+                f"the contact was stiffened to x{c['contact_stiffness']:g} "
+                + (f"with the step cut to 1/{c['cut']} " if c["cut"] > cut_before else
+                   "(the step kept: the normal forces are integrated backward) ")
+                + f"{where}: "
                 f"the pressures exceed the expected {n['expected_pressure_Pa']:.3g} Pa")})
         else:
             out.append({"kind": "step_cut", "level": "note", "text": (
                 f"a chunk failed at the run's step {where}; the run went on with the step cut to 1/{c['cut']}: a fast "
                 "event, not quasi-static there")})
-        k_before = c["contact_stiffness"]
+        k_before, cut_before = c["contact_stiffness"], c["cut"]
     return out
 
 

@@ -97,8 +97,9 @@ def spectral_bound(shell: Shell, mass_scale=1.0) -> list:
 
 
 def bending_operator(shell: Shell, n0: int, n1: int, stiffness):
-    """``K_b`` (n, n), a scipy sparse matrix, of ply nodes ``n0:n1`` for normal displacements of the flat blank, N/m:
-    ``sum_i A_i sum_f stiffness[f] g_if g_if^T`` (``stiffness`` (2,) N·m, one per fibre family)."""
+    """``K_b`` (n, n), a scipy sparse matrix, N/m, of ply nodes ``n0:n1`` for normal displacements of
+    the flat blank: ``sum_i A_i sum_f stiffness[f] g_if g_if^T`` (``stiffness`` (2,) N·m, one per
+    fibre family)."""
     import scipy.sparse as sp
 
     mesh = shell.mesh
@@ -119,38 +120,44 @@ def bending_operator(shell: Shell, n0: int, n1: int, stiffness):
     return k
 
 
-def ply_frequencies(shell: Shell, mass_scale=1.0) -> list:
-    """Per ply ``(omega_m, omega_b)``, rad/s: the membrane estimate and the bending eigenvalue of
-    :func:`stable_time_step` (module docstring)."""
+def membrane_frequency(shell: Shell, mass_scale=1.0) -> list:
+    """Per ply, the highest fibre-stretch frequency estimate ``omega_m = 2 c / l``, rad/s (host)."""
+    nodes = np.asarray(shell.mesh.nodes)
+    tris = np.asarray(shell.mesh.tris)
+    out = []
+    for (t0, t1), fab in zip(shell.mesh.ply_tris, shell.fabrics):
+        p = nodes[tris[t0:t1]]
+        el = np.linalg.norm(np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 1], p[:, 0] - p[:, 2]], 1), axis=-1)
+        alt = (2 * np.asarray(shell.ref.tri_area[t0:t1]) / el.max(axis=1)).min()
+        rho = float(np.max(np.asarray(fab.areal_mass))) * float(np.min(np.asarray(mass_scale)))
+        eh = float(np.max(np.asarray(fab.fibre_modulus))) * float(np.max(np.asarray(fab.thickness)))
+        out.append(2.0 * np.sqrt(eh / rho) / alt)
+    return out
+
+
+def bending_frequency(shell: Shell, mass_scale=1.0) -> list:
+    """Per ply, the largest bending frequency of the flat blank, rad/s (host; 0 without bending):
+    ``sqrt`` of the largest eigenvalue of ``M^-1 K_b`` (:func:`bending_operator` with the laws'
+    largest tangent stiffness, :func:`jaxform.materials.max_stiffness`; the lumped masses)."""
     import scipy.sparse as sp
 
     from jaxform.materials import max_stiffness
 
-    mesh = shell.mesh
-    nodes = np.asarray(mesh.nodes)
-    tris = np.asarray(mesh.tris)
+    m = np.asarray(shell.node_masses(mass_scale), np.float64)
     out = []
-    for (t0, t1), (n0, n1), fab in zip(mesh.ply_tris, mesh.ply_nodes, shell.fabrics):
-        p = nodes[tris[t0:t1]]
-        edges = np.stack([p[:, 1] - p[:, 0], p[:, 2] - p[:, 1], p[:, 0] - p[:, 2]], 1)
-        el = np.linalg.norm(edges, axis=-1)
-        area = np.asarray(shell.ref.tri_area[t0:t1])
-        alt = (2 * area / el.max(axis=1)).min()
-        rho = float(np.max(np.asarray(fab.areal_mass))) * float(np.min(np.asarray(mass_scale)))
-        eh = float(np.max(np.asarray(fab.fibre_modulus))) * float(np.max(np.asarray(fab.thickness)))
-        wm = 2.0 * np.sqrt(eh / rho) / alt
-        wb = 0.0
-        if fab.bending is not None:
-            b = [float(np.max(np.asarray(max_stiffness(law)))) for law in fab.bending]
-            s = sp.diags(1.0 / np.sqrt(rho * np.asarray(mesh.node_area[n0:n1], np.float64)))
-            wb = float(np.sqrt(top_eigenvalue(s @ bending_operator(shell, n0, n1, b) @ s)))
-        out.append((wm, wb))
+    for (n0, n1), fab in zip(shell.mesh.ply_nodes, shell.fabrics):
+        if fab.bending is None:
+            out.append(0.0)
+            continue
+        b = [float(np.max(np.asarray(max_stiffness(law)))) for law in fab.bending]
+        s = sp.diags(1.0 / np.sqrt(m[n0:n1]))
+        out.append(float(np.sqrt(top_eigenvalue(s @ bending_operator(shell, n0, n1, b) @ s))))
     return out
 
 
-def membrane_frequency(shell: Shell, mass_scale=1.0) -> list:
-    """Per ply, the highest fibre-stretch frequency estimate ``omega_m = 2 c / l``, rad/s (host)."""
-    return [wm for wm, _ in ply_frequencies(shell, mass_scale)]
+def ply_frequencies(shell: Shell, mass_scale=1.0) -> list:
+    """Per ply ``(omega_m, omega_b)``, rad/s: :func:`membrane_frequency` and :func:`bending_frequency`."""
+    return list(zip(membrane_frequency(shell, mass_scale), bending_frequency(shell, mass_scale)))
 
 
 def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_mass_factor: float = 1.0) -> float:
@@ -172,5 +179,5 @@ def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_ma
     return float(dt)
 
 
-__all__ = ["BOUND_MARGIN", "DENSE_NODES", "top_eigenvalue", "tension_stiffness", "spectral_bound", "bending_operator", "ply_frequencies", "membrane_frequency",
-           "stable_time_step"]
+__all__ = ["BOUND_MARGIN", "DENSE_NODES", "top_eigenvalue", "tension_stiffness", "spectral_bound", "bending_operator",
+           "membrane_frequency", "bending_frequency", "ply_frequencies", "stable_time_step"]

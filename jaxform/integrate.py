@@ -91,7 +91,8 @@ class Frames:
 
 def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, mass_scale: float = 1.0,
                damping: float = 0.0, gravity=(0.0, 0.0, 0.0), fixed=None, drive=None, loads: tuple = (),
-               dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_momentum_term: bool = False) -> Model:
+               dtype=None, fibre_mass_factor: float = 1.0, fibre_mass_momentum_term: bool = False,
+               dt_limit: float | None = None) -> Model:
     """Build a :class:`Model` on the host.
 
     ``dt`` defaults to ``safety`` times the stable limit (:func:`jaxform.spectrum.stable_time_step`);
@@ -102,13 +103,15 @@ def make_model(shell: Shell, *, dt: float | None = None, safety: float = 0.8, ma
     where they are); with a fibre mass, the added inertia couples free dofs only (a driven dof's
     motion does not load its free neighbours through it); ``fibre_mass_momentum_term`` adds the
     term the position-dependent fibre mass puts into the momentum equation
-    (:func:`jaxform.fibre_mass.geometric_force`).
+    (:func:`jaxform.fibre_mass.geometric_force`). ``dt_limit``: the stable step (safety 1) of
+    ``shell`` with these masses where the caller has computed it (:func:`jaxform.forming.build`).
     """
     dtype = dtype or (jnp.float64 if jax.config.jax_enable_x64 else jnp.float32)
     # first: it checks the factor (a clear error before any use of it)
     fm = _fm.fibre_mass(shell, fibre_mass_factor, mass_scale=mass_scale, dtype=dtype,
                         momentum_term=fibre_mass_momentum_term)
-    dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
+    if dt_limit is None:
+        dt_limit = stable_time_step(shell, mass_scale=mass_scale, safety=1.0, fibre_mass_factor=fibre_mass_factor)
     if dt is None:
         dt = safety * dt_limit
     elif dt > dt_limit:

@@ -160,7 +160,8 @@ def ply_frequencies(shell: Shell, mass_scale=1.0) -> list:
     return list(zip(membrane_frequency(shell, mass_scale), bending_frequency(shell, mass_scale)))
 
 
-def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_mass_factor: float = 1.0) -> float:
+def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_mass_factor: float = 1.0,
+                     frequencies: list | None = None) -> float:
     """Largest stable central-difference time step of the shell, s (host):
     ``dt = safety * 2 / sqrt(omega_t^2 + omega_b^2)`` over the plies, ``omega_b`` the bending
     eigenvalue of :func:`ply_frequencies` and ``omega_t`` the fibre tension's (the two add as a
@@ -169,11 +170,13 @@ def stable_time_step(shell: Shell, mass_scale=1.0, safety: float = 0.8, fibre_ma
     the fibre mass's degree is chosen to hold in every state; with the lumped mass alone
     ``omega_t = sqrt(X)`` (:func:`spectral_bound`, every state; 1.02-1.06x ``omega_m``). The test
     suite checks it against the largest eigenfrequency of the assembled shell (power iteration
-    through the shell's forces)."""
+    through the shell's forces). ``frequencies``: :func:`ply_frequencies` of ``shell`` at
+    ``mass_scale`` where the caller has them (the bending eigenvalue takes about 1 s on Case B's
+    1 mm stack)."""
     s = float(fibre_mass_factor)
     bounds = spectral_bound(shell, mass_scale) if s <= 1.0 else [None] * len(shell.fabrics)
     dt = np.inf
-    for (wm, wb), x in zip(ply_frequencies(shell, mass_scale), bounds):
+    for (wm, wb), x in zip(ply_frequencies(shell, mass_scale) if frequencies is None else frequencies, bounds):
         wt = wm / s if x is None else max(wm, float(np.sqrt(x)))
         dt = min(dt, safety * 2.0 / np.sqrt(wt**2 + wb**2))
     return float(dt)

@@ -37,7 +37,7 @@ FIBRE_MASS_RESERVE = 1.25
 """The automatic fibre-mass factor brings the step to within this factor of the bending limit."""
 
 
-def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False) -> float:
+def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False, frequencies: list | None = None) -> float:
     """``numerics.fibre_mass_scaling = "auto"``: the smallest factor ``s`` that brings the shell's
     stable step to within :data:`FIBRE_MASS_RESERVE` of its bending limit (``sqrt(omega_b^2 +
     (omega_m / s)^2) <= 1.25 omega_b``, i.e. ``s >= omega_m / (0.75 omega_b)``: more would buy
@@ -48,9 +48,10 @@ def auto_fibre_mass(shell: Shell, mass_scale=1.0, momentum_term: bool = False) -
     :func:`jaxform.spectrum.ply_frequencies`); NCF (+-45 deg): 3 (72, 37 and 18 wanted at 8, 4
     and 2 mm); membrane only: 12. With the fibre mass's momentum term (``momentum_term``,
     :func:`jaxform.fibre_mass.geometric_force`) the off-axis cap does not apply: NCF Case A ran to
-    completion with 12 at 4 mm (183 s, as with 3) and 2 mm (2449 s; 6 without the term: 1385 s)."""
+    completion with 12 at 4 mm (183 s, as with 3) and 2 mm (2449 s; 6 without the term: 1385 s).
+    ``frequencies``: :func:`jaxform.spectrum.ply_frequencies` where the caller has them."""
     need, cap = 1.0, FIBRE_MASS_MAX
-    for (wm, wb), fab in zip(ply_frequencies(shell, mass_scale), shell.fabrics):
+    for (wm, wb), fab in zip(ply_frequencies(shell, mass_scale) if frequencies is None else frequencies, shell.fabrics):
         need = max(need, FIBRE_MASS_MAX if wb <= 0 else wm / (math.sqrt(FIBRE_MASS_RESERVE**2 - 1.0) * wb))
         if not along_edges(fab.fibre_angles) and not momentum_term:
             cap = min(cap, FIBRE_MASS_MAX_OFF_AXIS)

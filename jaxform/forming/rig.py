@@ -45,7 +45,7 @@ from jaxform.forming.numerics import (AUTO_SAFETY, STACKED_CONTACTS, ContactNume
 from jaxform.mesh import Mesh
 from jaxform.self_contact import self_contact_load
 from jaxform.shell import Shell
-from jaxform.spectrum import stable_time_step
+from jaxform.spectrum import ply_frequencies, stable_time_step
 
 PUNCH, DIE, HOLDER = 0, 1, 2
 """Indices of the three tools in ``model.loads``."""
@@ -382,9 +382,10 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     fabrics = ply_fabrics(case, fabric)
     shell = Shell.build(mesh, fabrics, shear_reading=case.fabric.shear_reading)
     ms = float(case.mass_scaling)
-    fms = (auto_fibre_mass(shell, ms, momentum_term=case.fibre_mass_momentum_term) if case.fibre_mass_scaling is None
-           else float(case.fibre_mass_scaling))
-    stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms)
+    freqs = ply_frequencies(shell, ms)  # once: the bending eigenvalue is a sparse solve (about 1 s at 1 mm)
+    fms = (auto_fibre_mass(shell, ms, momentum_term=case.fibre_mass_momentum_term, frequencies=freqs)
+           if case.fibre_mass_scaling is None else float(case.fibre_mass_scaling))
+    stable = stable_time_step(shell, mass_scale=ms, safety=1.0, fibre_mass_factor=fms, frequencies=freqs)
     numerics = contact_numerics(case, fabrics, stable, dt, dt_safety)
     if numerics.budget > 1.0:
         warnings.warn(f"forming.build: the time step and contact stiffness given make a node between "
@@ -408,7 +409,8 @@ def build(case: Case, *, dtype=None, dt: float | None = None, dt_safety: float =
     loads, holder_state = _loads(case, mesh, fabrics, dt, jdtype, safety, numerics.implicit_normal)
     model = integrate.make_model(shell, dt=dt, mass_scale=ms, damping=damping,
                                  gravity=(0.0, 0.0, -units.GRAVITY / ms), loads=loads, dtype=jdtype,
-                                 fibre_mass_factor=fms, fibre_mass_momentum_term=case.fibre_mass_momentum_term)
+                                 fibre_mass_factor=fms, fibre_mass_momentum_term=case.fibre_mass_momentum_term,
+                                 dt_limit=stable)
     x0 = jnp.asarray(mesh.nodes, jdtype)
     # jitted: eager (op-by-op) evaluation of the shell forces and of the contact searches costs
     # seconds to minutes (each operation compiled on its own)

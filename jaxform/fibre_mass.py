@@ -37,6 +37,10 @@ construction as Runge-Kutta-Chebyshev stability polynomials), normalised to ``q(
 
 Cost: ``n - 1`` products with ``K_t`` per step (gathers, a few multiply-adds, a scatter), no
 reductions, no convergence test, fixed shapes; differentiable as any other loop of ``jit`` code.
+Where the fibres run along the mesh's grid lines (woven 0/90 on the square blank) ``K_t`` is a set
+of springs between nodes a fixed index apart (:func:`grid_springs`), and a product is a few
+differences of shifted arrays: 0.14 against 0.42 ms at 2 mm (woven Case A, 15,625 nodes, two
+cores), a step at factor 12 10.8 against 14.8 ms.
 (A Jacobi-preconditioned conjugate-gradient solve with ``M + alpha K_t`` needed about ``2 s``
 iterations of a dearer kind, warm starts did not help: 28 ms/step at ``s = 10`` against 19 ms
 with this polynomial, 2 mm hemisphere, two cores.)
@@ -80,7 +84,11 @@ class FibreMass:
 
     Attributes:
         weight: (2, T) ``A (E h)_f / X`` per fibre family and triangle (``X`` of the triangle's
-            ply), kg·m²: ``K_t / X``, see :func:`stiffness_times`.
+            ply), kg·m²: ``K_t / X``, see :func:`stiffness_times`; ``None`` where ``springs`` hold it.
+        springs: ``K_t / X`` of a mesh whose fibres run along its edges (:func:`grid_springs`), a
+            tuple of (N - stride,) spring weights, kg, one per entry of ``strides``; else ``None``.
+        strides: static, the node-index distances of the springs' two ends (a grid's 1 and row
+            length); empty for the triangle form.
         degree: static, the Chebyshev degree ``n`` (``n - 1`` products with ``K_t`` per step).
         factor: static, the factor ``s`` the membrane step limit grows by (for reports).
         geometric: static, the momentum equation has the term a position-dependent mass adds,
@@ -92,6 +100,8 @@ class FibreMass:
     degree: int = static_field()
     factor: float = static_field(default=1.0)
     geometric: bool = static_field(default=False)
+    springs: Any = None
+    strides: tuple = static_field(default=())
 
 
 @functools.lru_cache(maxsize=None)
@@ -140,11 +150,12 @@ def degree_for(factor: float, bound: float, omega_m: float) -> int:
 
 
 def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, dtype=jnp.float32,
-               momentum_term: bool = False) -> FibreMass | None:
+               momentum_term: bool = False, springs: bool = True) -> FibreMass | None:
     """The :class:`FibreMass` that grows the membrane step limit of ``shell`` by ``factor`` (>= 1;
     1 gives ``None``: the lumped mass alone). Host-side; one degree for all plies (the largest
     any ply needs), each ply's stiffness scaled by its own bound; ``momentum_term``: see
-    :attr:`FibreMass.geometric`."""
+    :attr:`FibreMass.geometric`; ``springs``: the springs' form where the mesh allows
+    (:func:`grid_springs`; the same operator, faster), else the triangles'."""
     factor = float(factor)
     if not np.isfinite(factor) or factor < 1.0:
         raise ValueError(f"fibre_mass: factor = {factor!r}: must be a finite number >= 1 (1 = off)")
@@ -157,11 +168,64 @@ def fibre_mass(shell: Shell, factor: float, *, mass_scale=1.0, dtype=jnp.float32
     for (t0, t1), fab, x in zip(shell.mesh.ply_tris, shell.fabrics, bounds):
         eh = tension_stiffness(fab)
         w[:, t0:t1] = area[None, t0:t1] * eh[:, None] / x
-    return FibreMass(weight=jnp.asarray(w, dtype), degree=n, factor=factor, geometric=bool(momentum_term))
+    springs = grid_springs(shell, w) if springs else None
+    if springs is None:
+        return FibreMass(weight=jnp.asarray(w, dtype), degree=n, factor=factor, geometric=bool(momentum_term))
+    return FibreMass(weight=None, degree=n, factor=factor, geometric=bool(momentum_term),
+                     springs=tuple(jnp.asarray(k, dtype) for k in springs.values()), strides=tuple(springs))
 
 
-def fibre_units(xs, shell: Shell):
-    """Unit current fibre directions per triangle at positions ``xs`` (3, N): two (3, T) arrays."""
+MAX_STRIDES = 4
+""":func:`grid_springs` gives up beyond this many strides (each costs a pass over the nodes)."""
+
+
+def grid_springs(shell: Shell, weight) -> dict | None:
+    """``K_t`` as springs between node pairs, where the mesh allows: ``{stride: (N - stride,)
+    weights}``, the spring from node ``k`` to ``k + stride`` weighing ``weight[k]`` (0: none), or
+    ``None`` (host, float64; ``weight`` (2, T) the triangle form's weights).
+
+    Where a triangle has a leg along a fibre (a grid whose lines are the fibres: woven 0/90 on the
+    blank's grid), the fibre's gradient ``g_f = sum_a c_a x_a`` is that leg's vector over its
+    reference length (``c = -c_j, c_j, 0``), so its term of ``K_t`` is a spring along the current
+    leg, ``w c_j^2 (d d^T)`` on the leg's two nodes, and the two triangles that share the leg add
+    their weights on the same spring. ``K_t p`` is then two differences of shifted arrays per
+    stride (about 3x faster than the triangles' gathers at 2 mm). ``None`` where a triangle's
+    fibre spans all three corners (fibres off the grid lines: the +-45 deg NCF) or the pairs' node
+    distances take more than :data:`MAX_STRIDES` values."""
+    tris = np.asarray(shell.mesh.tris)
+    coef = np.asarray(shell.ref.tri_coef, np.float64)
+    out: dict = {}
+    for f in range(2):
+        c = np.stack([-(coef[:, f, 0] + coef[:, f, 1]), coef[:, f, 0], coef[:, f, 1]], 1)
+        scale = np.abs(c).max(axis=1)
+        leg = np.abs(c) > 1e-9 * scale[:, None]
+        if not np.all(leg.sum(axis=1) == 2):
+            return None
+        k = np.argsort(~leg, axis=1, kind="stable")[:, :2]
+        ends, cs = np.take_along_axis(tris, k, 1), np.take_along_axis(c, k, 1)
+        if np.any(np.abs(cs.sum(axis=1)) > 1e-9 * scale):
+            return None
+        a, stride = ends.min(axis=1), np.abs(ends[:, 1] - ends[:, 0])
+        for d in np.unique(stride):
+            if d not in out:
+                if len(out) == MAX_STRIDES:
+                    return None
+                out[int(d)] = np.zeros(shell.mesh.nodes.shape[0] - int(d))
+            on = stride == d
+            np.add.at(out[int(d)], a[on], weight[f, on] * cs[on, 0] ** 2)
+    return dict(sorted(out.items()))
+
+
+def fibre_units(xs, fm: FibreMass | None, shell: Shell):
+    """Unit current fibre directions at positions ``xs`` (3, N): per triangle, two (3, T) arrays;
+    in ``fm``'s spring form (:func:`grid_springs`) per spring, one (3, N - stride) array per stride
+    (0 where no spring)."""
+    if fm is not None and fm.strides:
+        out = []
+        for d, w in zip(fm.strides, fm.springs):
+            g = xs[:, d:] - xs[:, :-d]
+            out.append(jnp.where(w > 0, g / jnp.where(w > 0, _stretch(g), 1.0), 0.0))
+        return tuple(out)
     e1, e2 = _edges(xs, shell.mesh)
     g1, g2 = _fibres_soa(e1, e2, shell.ref.tri_coef.astype(xs.dtype))
     return g1 / _stretch(g1), g2 / _stretch(g2)
@@ -177,6 +241,12 @@ def stretch_rates(vs, units, shell: Shell):
 def stiffness_times(ps, units, fm: FibreMass, shell: Shell):
     """``K_t p / X`` (3, N), kg times the units of ``p``, for structure-of-arrays vectors ``ps``
     (3, N) with the fibre directions ``units`` (:func:`fibre_units`)."""
+    if fm.strides:  # springs from node k to k + d: -q on k, +q on k + d
+        out = jnp.zeros_like(ps)
+        for d, w, u in zip(fm.strides, fm.springs, units):
+            q = (w.astype(ps.dtype) * _dot(u, ps[:, d:] - ps[:, :-d])) * u
+            out = out.at[:, d:].add(q).at[:, :-d].add(-q)
+        return out
     s = stretch_rates(ps, units, shell) * fm.weight.astype(ps.dtype)
     coef = shell.ref.tri_coef.astype(ps.dtype)
     q1, q2 = s[0] * units[0], s[1] * units[1]
@@ -216,10 +286,10 @@ def geometric_force(xs, ps, mass, free, fm: FibreMass, shell: Shell):
     ps = jax.lax.stop_gradient(ps)
 
     def kinetic(x):
-        return 0.5 * jnp.sum(ps * inverse_mass_times(ps, fibre_units(x, shell), mass, free, fm, shell))
+        return 0.5 * jnp.sum(ps * inverse_mass_times(ps, fibre_units(x, fm, shell), mass, free, fm, shell))
 
     return -jax.grad(kinetic)(xs)
 
 
-__all__ = ["FibreMass", "geometric_force", "fibre_mass", "degree_for",
+__all__ = ["FibreMass", "MAX_STRIDES", "geometric_force", "fibre_mass", "grid_springs", "degree_for",
            "chebyshev", "peak", "fibre_units", "stretch_rates", "stiffness_times", "inverse_mass_times"]

@@ -208,7 +208,7 @@ def _step(model: Model, state: State, x_ref):
     if fm is None:
         v_free = p_new / m
     else:
-        v_free = _fm.inverse_mass_times(p_new, _fm.fibre_units(xs, model.shell), model.mass, free, fm, model.shell)
+        v_free = _fm.inverse_mass_times(p_new, _fm.fibre_units(xs, fm, model.shell), model.mass, free, fm, model.shell)
     x_drive = model.drive.position(t + dt).T
     v_drive = (x_drive - xs) / dt
     v_new = jnp.where(fixed, v_drive, v_free)

@@ -22,8 +22,8 @@ def _shell(angles=(0.0, np.pi / 2), fabric=WOVEN_38616, size=0.005):
     return Shell.build(mesh, fabric.replace(fibre_angles=angles))
 
 
-def _units(shell):
-    return F.fibre_units(jnp.asarray(shell.mesh.nodes).T, shell)
+def _units(shell, fm):
+    return F.fibre_units(jnp.asarray(shell.mesh.nodes).T, fm, shell)
 
 
 def _bound(shell):
@@ -31,16 +31,20 @@ def _bound(shell):
     return x
 
 
+@pytest.mark.parametrize("springs", [True, False])
 @pytest.mark.parametrize("angles,fabric", [((0.0, np.pi / 2), WOVEN_38616), ((np.pi / 4, -np.pi / 4), NCF_FCIM359),
                                            ((0.3, 1.5), WOVEN_38616)])
-def test_stiffness_is_the_tension_hessian_over_the_bound(angles, fabric):
+def test_stiffness_is_the_tension_hessian_over_the_bound(angles, fabric, springs):
+    """``K_t / X`` against the shell's tension Hessian; the springs' form (fibres along the grid's
+    lines) and the triangles' form alike."""
     shell = _shell(angles, fabric)
-    fm = F.fibre_mass(shell, 4.0, dtype=jnp.float64)
+    fm = F.fibre_mass(shell, 4.0, dtype=jnp.float64, springs=springs)
+    assert bool(fm.strides) == (springs and angles == (0.0, np.pi / 2))
     xs = jnp.asarray(shell.mesh.nodes).T
     p = jnp.asarray(np.random.default_rng(1).normal(size=xs.shape))
     # at the flat reference (all stretches 1) the tension Hessian has no geometric part
     k_p = -jax.jvp(lambda y: forces_and_energy_soa(y, shell, weights=(1.0, 0.0, 0.0))[0], (xs,), (p,))[1]
-    np.testing.assert_allclose(_bound(shell) * F.stiffness_times(p, _units(shell), fm, shell), k_p, rtol=1e-10,
+    np.testing.assert_allclose(_bound(shell) * F.stiffness_times(p, _units(shell, fm), fm, shell), k_p, rtol=1e-10,
                                atol=1e-12 * float(jnp.max(jnp.abs(k_p))))
 
 
@@ -75,10 +79,10 @@ def test_spectral_bound_holds_for_any_fibre_directions_and_is_not_loose():
     """``X`` bounds ``M^-1 K_t`` whatever the current fibre directions (power iteration): at the
     reference, sheared 50 degrees, and with random directions per triangle."""
     shell = _shell(size=0.004)
-    fm = F.fibre_mass(shell, 4.0, dtype=jnp.float64)
+    fm = F.fibre_mass(shell, 4.0, dtype=jnp.float64, springs=False)  # directions per triangle
     x = _bound(shell)
     m = jnp.asarray(shell.node_masses())[None, :]
-    u1, u2 = _units(shell)
+    u1, u2 = _units(shell, fm)
     rng = np.random.default_rng(3)
     rand = [jnp.asarray(r / np.linalg.norm(r, axis=0)) for r in rng.normal(size=(2, 3, u1.shape[1]))]
     sheared = (u1, np.cos(np.radians(40.0)) * u1 + np.sin(np.radians(40.0)) * u2)
@@ -119,7 +123,7 @@ def test_spectral_bound_by_lanczos_agrees_with_the_dense_eigensolver_and_falls_b
 def test_polynomial_inverse_mass_keeps_inextensible_motion_and_is_symmetric_positive_and_heavier():
     shell = _shell()
     fm = F.fibre_mass(shell, 5.0, dtype=jnp.float64)
-    units = _units(shell)
+    units = _units(shell, fm)
     mass = jnp.asarray(shell.node_masses())
     X = np.asarray(shell.mesh.nodes)
     free = jnp.ones((3, len(X)))
@@ -166,7 +170,7 @@ def _largest_frequency(shell, fm):
     """Power iteration on C K (or M^-1 K)."""
     x0 = jnp.asarray(shell.mesh.nodes)
     mass = shell.node_masses()
-    units = F.fibre_units(x0.T, shell)
+    units = F.fibre_units(x0.T, fm, shell)
 
     @jax.jit
     def apply(u):
@@ -447,7 +451,7 @@ def test_the_blank_s_shell_forces_and_fibre_mass_keep_its_mirror_symmetry():
         f = lambda u: np.asarray(forces_and_energy_soa(jnp.asarray(u).T, shell, displacement=True)[0]).T  # noqa: E731
 
         def c(u, p):
-            units = F.fibre_units(jnp.asarray(x0 + u).T, shell)
+            units = F.fibre_units(jnp.asarray(x0 + u).T, fm, shell)
             return np.asarray(F.inverse_mass_times(jnp.asarray(p).T, units, shell.node_masses(), jnp.ones((3, len(x0))),
                                                    fm, shell)).T
 

@@ -1,6 +1,7 @@
 """Wrinkle sections and the fit of the bending law from them (issue 16): the data's edge checks,
 the position-tolerant residual, the pieces of the fit, and the script's refusals. The fit itself
 runs end to end in notebook 07's test and in ``benchmarks/bench_wrinkle_fit.py``."""
+import dataclasses
 import math
 import re
 import threading
@@ -9,12 +10,13 @@ import jax.numpy as jnp
 import numpy as np
 import pytest
 
-from jaxform import cases
+from jaxform import cases, forming
 from jaxform.calibrate import sections as S
 from jaxform.calibrate.sections import Section
 from jaxform.contact import ToolLoad
 from jaxform.calibrate import section_runs
 from jaxform.calibrate import wrinkle_fit as wf
+from jaxform.calibrate.transforms import law_from_q
 from jaxform.calibrate.uncertainty import MISFIT_P
 from jaxform.io import calibration_files as cf
 from jaxform.materials import LinearBending, PolynomialShear, VoceBending, preset
@@ -134,6 +136,27 @@ def test_the_fit_s_imperfect_blanks_start_clear_of_the_tools():
             if isinstance(ld, ToolLoad):
                 gap0, gap = np.asarray(ld.gap(state.x, state.t, ls)), np.asarray(ld.gap(x, state.t, ls))
                 assert np.all(gap >= np.minimum(gap0, 0.0) - 1e-12)  # nobody pushed into a tool
+
+
+def test_the_fit_s_step_is_built_for_the_stiffest_law_it_will_run():
+    """A trial law stiffer than the start raises the shell's bending frequency; on the start's step it
+    could outrun the explicit limit. ``step_b_init`` (the fit passes its box's largest B_init) builds the
+    rig's step for that law, as ``forming.build`` gives it, and keeps the start law as ``law0``; a
+    value below the start's changes nothing."""
+    case = cases.resolve("case-a-woven-nlbm", element_size=25e-3)
+    sec = Section(s=np.linspace(0.0, 0.03, 31), amplitude=np.zeros(31), start=np.array([0.06, 0.0]),
+                  end=np.array([0.09, 0.0]))
+    own = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1)
+    b0 = float(np.exp(wf.q_from_law(own.law0, "voce")[0]))
+    softer = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1, step_b_init=0.5 * b0)
+    stiff = section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1, step_b_init=1000.0 * b0)
+    assert float(softer.rig[0].dt) == float(own.rig[0].dt)
+    law = law_from_q(wf.q_from_law(own.law0, "voce") + [np.log(1000.0), 0.0, 0.0], "voce")
+    frames = dataclasses.replace(case, process=dataclasses.replace(case.process, frames=section_runs.GRAD_FRAMES))
+    want = forming.build(frames, fabric=forming.build_fabric(case).replace(bending=(law, law))).info.dt
+    assert float(stiff.rig[0].dt) == pytest.approx(want, rel=1e-12)
+    assert float(stiff.rig[0].dt) < 0.95 * float(own.rig[0].dt)  # bending sets this law's step at 25 mm
+    assert wf.q_from_law(stiff.law0, "voce") == pytest.approx(wf.q_from_law(own.law0, "voce"))
 
 
 @pytest.mark.parametrize("width,workers", [(2, 1), (1, 2)])

@@ -87,19 +87,36 @@ def parallel(width: int | None, workers: int | None, wide: int) -> tuple[int, in
             int(workers) if workers is not None else cores() if cpu else 1)
 
 
+def start_law(case):
+    """The Voce law a fit of ``case`` starts from (:func:`~jaxform.calibrate.transforms.voce_start` of the
+    case's); refuses a membrane-only case."""
+    fab = forming.build_fabric(case)
+    if fab.bending is None:
+        raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
+    return voce_start(fab.bending[0])
+
+
 class SectionRuns:
     """The forming rig built once; members ``(q, seed)`` run in batches of fixed width, cached by ``q``;
-    ``workers`` batches at a time (threads: a CPU's cores each run one)."""
+    ``workers`` batches at a time (threads: a CPU's cores each run one). ``step_b_init`` (N·m): the
+    largest ``B_init`` the runs will meet (a fit's box); where it exceeds the start's, the rig's step
+    is the one that law allows (a stiffer law raises the shell's bending frequency: on the start's
+    step it could outrun the explicit limit and fail, or bias a fit towards soft laws)."""
 
-    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply, workers=1):
-        rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)))
-        model, state, info = rig
-        fab = model.shell.fabrics[0]
-        if fab.bending is None:
-            raise ValueError(f"fit_wrinkles: case {case.name!r} is membrane-only; there is no bending law to fit")
+    def __init__(self, case, sections, param_kind, seeds, imperfection, width, ply, workers=1, step_b_init=None):
         if not 1 <= ply <= case.n_plies:
             raise ValueError(f"fit_wrinkles: ply = {ply}: the case has plies 1..{case.n_plies}")
-        self.law0, self.width, self.seeds, self.workers = voce_start(fab.bending[0]), int(width), int(seeds), int(workers)
+        self.law0 = start_law(case)
+        q0 = q_from_law(self.law0, "voce")
+        step_law = None  # the step is built for the stiffest law the runs will meet (tangent at most B_init)
+        if step_b_init is not None and float(step_b_init) > math.exp(q0[0]):
+            stiff = law_from_q(np.array([math.log(float(step_b_init)), q0[1], q0[2]]), "voce")
+            step_law = forming.build_fabric(case).replace(bending=(stiff, stiff))
+        rig = forming.build(dataclasses.replace(case, process=dataclasses.replace(case.process, frames=GRAD_FRAMES)),
+                            fabric=step_law)
+        model, state, info = rig
+        fab = model.shell.fabrics[0]
+        self.width, self.seeds, self.workers = int(width), int(seeds), int(workers)
         self.dtype = state.x.dtype
         sel = np.asarray(info.ply_id) == ply
         local = np.cumsum(sel) - 1
@@ -202,7 +219,7 @@ def section_loss(case, sections: Sequence, qs, *, noise: float = sec_mod.NOISE, 
         sec_mod.check_section(s, case)
     qs = [np.asarray(q, float) for q in qs]
     width, workers = parallel(None, None, len(qs))
-    runs = SectionRuns(case, sections, "voce", 1, 0.0, width, ply, workers)
+    runs = SectionRuns(case, sections, "voce", 1, 0.0, width, ply, workers, step_b_init=math.exp(max(q[0] for q in qs)))
     R = sec_mod.weights(sections, noise, smoothing if smoothing is not None else float(case.element_size))
     meas = np.concatenate([s.amplitude for s in sections])
     evs = runs.evaluate(qs)
@@ -217,8 +234,9 @@ def predict_sections(case, sections: Sequence, law=None, *, shear_scale: float =
     kind = "voce" if shear_scale == 1.0 else "voce+shear"
     for s in sections:
         sec_mod.check_section(s, case)
-    runs = SectionRuns(case, sections, kind, 1, 0.0, 1, ply)
-    q = np.append(q_from_law(voce_start(law) if law is not None else runs.law0, "voce"),
+    q_law = None if law is None else q_from_law(voce_start(law), "voce")
+    runs = SectionRuns(case, sections, kind, 1, 0.0, 1, ply, step_b_init=None if law is None else math.exp(q_law[0]))
+    q = np.append(q_law if law is not None else q_from_law(runs.law0, "voce"),
                   [] if kind == "voce" else [math.log(shear_scale)])
     y, valid, ok, _ = runs.evaluate([q])[0]
     if not ok:
@@ -240,4 +258,4 @@ def sections_of(case, lines: dict, law=None, *, spacing: float = 1e-3, ply: int 
             for s, (y, v) in zip(raw, predict_sections(case, raw, law, ply=ply))]
 
 
-__all__ = ["GRAD_FRAMES", "KAPPA_PERCENTILE", "SectionRuns", "section_loss", "predict_sections", "sections_of"]
+__all__ = ["GRAD_FRAMES", "KAPPA_PERCENTILE", "start_law", "SectionRuns", "section_loss", "predict_sections", "sections_of"]

@@ -82,7 +82,7 @@ from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.cantilever_data import estimate_noise
 from jaxform.calibrate.cantilever_fit import DETERMINED_RATIO, GN_TOL, ProfileModel, fit_cantilever
 from jaxform.calibrate.imperfections import imperfections
-from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, section_loss, sections_of
+from jaxform.calibrate.section_runs import SectionRuns, parallel, predict_sections, section_loss, sections_of, start_law
 from jaxform.calibrate.transforms import _physical, law_from_q, moment_band, q_from_law, scaled_shear, voce_start
 from jaxform.calibrate.uncertainty import (EXTEND_ROUNDS, block_misfit, checked_covariance, describe_axis, open_share,
                                            scatter_covariance)
@@ -243,7 +243,8 @@ def fit_wrinkles(case, sections: Sequence, *, params: str = "voce", profiles: Se
     p = 3 if params == "voce" else 4
     batch_width, workers = parallel(batch_width, workers, 2 * p)
     imperfection = 0.1 * case.ply_thickness if imperfection is None else float(imperfection)
-    runs = SectionRuns(case, sections, params, int(seeds), imperfection, batch_width, ply, workers)
+    runs = SectionRuns(case, sections, params, int(seeds), imperfection, batch_width, ply, workers,
+                       step_b_init=SPAN * math.exp(q_from_law(start_law(case), "voce")[0]))  # the box's stiffest
     R = sec_mod.weights(sections, noise, width)  # (rows, M): y -> section rows
     cuts = np.cumsum([0] + [len(s.s) for s in sections])
     meas = np.concatenate([s.amplitude for s in sections])

@@ -21,8 +21,12 @@ from jaxform.spectrum import ply_frequencies
 
 FIBRE_MASS_MAX = 12.0
 """The largest automatic fibre-mass factor for plies whose fibres run along the square blank's
-edges: the largest run to completion here (woven Case A at 2 mm, twice; beyond the bending limit
-more is useless anyway)."""
+edges: the largest run to completion here (woven Case A at 2 mm, twice). More fails: woven Case A
+NLBM at 4 mm (``benchmarks/results/fibre-springs-20261207``) with 24 blew up at 27 mm of stroke
+without the momentum term and at 35 and 48 mm with it (the step cut to 1/8 did not save it), and
+with 48 at 17 mm, then needed the term, step cuts to 1/8 and the contact 64x stiffer to finish,
+9.7 deg (p95) from the run with 12; the products a larger factor costs would have bought at most
+2.3x fewer steps' time at 2 mm."""
 FIBRE_MASS_MAX_OFF_AXIS = 3.0
 """The largest automatic factor for plies whose fibres run off the blank's edges (more than 10
 degrees, e.g. the +-45 deg NCF). Their corners are held in-plane by shear alone and whip, and the

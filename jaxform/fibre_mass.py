@@ -73,7 +73,8 @@ import numpy as np
 
 from jaxform._pytree import pytree_dataclass, static_field
 from jaxform.mesh import assemble_corners
-from jaxform.shell import Shell, _dot, _edges, _fibres_soa, _stretch
+from jaxform.shell import Shell
+from jaxform.shell_kinematics import _dot, _edges, _fibres_soa, _stretch
 from jaxform.spectrum import membrane_frequency, spectral_bound, tension_stiffness
 ETA = 0.05  # Chebyshev damping: keeps q > 0 (undamped, q has zeros: modes of infinite mass)
 

@@ -45,6 +45,7 @@ from jaxform import validate
 from jaxform._pytree import as_leaf, is_concrete, pytree_dataclass, static_field
 from jaxform.geometry import EZ as _EZ
 from jaxform.geometry import closest_point_triangle, safe_norm, safe_normalize  # noqa: F401  (re-exported)
+from jaxform.revolved import hemisphere_on_shank, radial, revolved_normal, rounded_halfstrip
 
 
 # ---------------------------------------------------------------------------------------------
@@ -120,27 +121,6 @@ STILL = VerticalMotion(0.0, 0.0, math.inf)
 # ---------------------------------------------------------------------------------------------
 
 
-def _radial(p):
-    """Distance from the z axis, m (safe at the axis)."""
-    return safe_norm(p[:2])
-
-
-def _rounded_halfstrip(r, z, r_in, z_lo, z_hi, radius):
-    """Exact signed distance to ``{r >= r_in, z_lo <= z <= z_hi}`` with its two inner edges rounded.
-
-    The region is the half-infinite strip ``{r >= r_in + radius, z_lo + radius <= z <= z_hi -
-    radius}`` dilated by ``radius``, so its distance is the strip's minus ``radius`` (exact).
-    """
-    zc = 0.5 * (z_lo + z_hi)
-    half = 0.5 * (z_hi - z_lo) - radius
-    dx = (r_in + radius) - r
-    dz = jnp.abs(z - zc) - half
-    d = jnp.stack([dx, dz])
-    outside = safe_norm(jnp.maximum(d, 0.0))
-    inside = jnp.minimum(jnp.maximum(dx, dz), 0.0)
-    return outside + inside - radius
-
-
 @pytree_dataclass
 class Punch:
     """Hemispherical punch, apex down, on a cylindrical shank of the same radius going up (to +inf).
@@ -175,18 +155,24 @@ class Punch:
             validate.finite("Punch", "axis_xy", self.axis_xy, "m")
             object.__setattr__(self, "axis_xy", as_leaf(self.axis_xy))
 
-    def phi_local(self, p):
-        """Signed distance, m, of one point (3,) in the reference pose."""
+    def _distance(self, p):
+        """``(phi, grad phi)`` of one point (3,) in the reference pose (:func:`~jaxform.revolved.hemisphere_on_shank`)."""
         if self.axis_xy is not None:
             axis = jnp.asarray(self.axis_xy, p.dtype)
             p = jnp.stack([p[0] - axis[0], p[1] - axis[1], p[2]])
         if self.apex_up:
             p = jnp.stack([p[0], p[1], 2.0 * self.apex_z - p[2]])
-        c = jnp.stack([0.0 * p[0], 0.0 * p[1], self.apex_z + self.radius + 0.0 * p[2]])
-        d = p - c
-        sphere = safe_norm(d) - self.radius
-        shank = _radial(p) - self.radius
-        return jnp.where(d[2] >= 0, shank, sphere)
+        phi, g = hemisphere_on_shank(p, self.apex_z, self.radius)
+        return phi, (g * jnp.asarray([1.0, 1.0, -1.0], g.dtype) if self.apex_up else g)
+
+    def phi_local(self, p):
+        """Signed distance, m, of one point (3,) in the reference pose."""
+        return self._distance(p)[0]
+
+    def phi_normal_local(self, p):
+        """``(phi, outward unit normal)`` of one point (3,), the gradient in closed form."""
+        phi, g = self._distance(p)
+        return phi, safe_normalize(g)
 
 
 @pytree_dataclass
@@ -218,11 +204,17 @@ class Die:
             for n in ("opening_radius", "fillet_radius", "thickness", "top_z"):
                 object.__setattr__(self, n, as_leaf(getattr(self, n)))
 
+    def _distance(self, p):
+        return rounded_halfstrip(radial(p), p[2], self.opening_radius, self.top_z - self.thickness, self.top_z,
+                                 self.fillet_radius)
+
     def phi_local(self, p):
         """Signed distance, m, of one point (3,) in the reference pose."""
-        return _rounded_halfstrip(
-            _radial(p), p[2], self.opening_radius, self.top_z - self.thickness, self.top_z, self.fillet_radius
-        )
+        return self._distance(p)[0]
+
+    def phi_normal_local(self, p):
+        """``(phi, outward unit normal)`` of one point (3,), the gradient in closed form."""
+        return revolved_normal(p, *self._distance(p))
 
 
 @pytree_dataclass
@@ -253,11 +245,17 @@ class BlankHolder:
             for n in ("opening_radius", "edge_radius", "thickness", "bottom_z"):
                 object.__setattr__(self, n, as_leaf(getattr(self, n)))
 
+    def _distance(self, p):
+        return rounded_halfstrip(radial(p), p[2], self.opening_radius, self.bottom_z, self.bottom_z + self.thickness,
+                                 self.edge_radius)
+
     def phi_local(self, p):
         """Signed distance, m, of one point (3,) in the reference pose."""
-        return _rounded_halfstrip(
-            _radial(p), p[2], self.opening_radius, self.bottom_z, self.bottom_z + self.thickness, self.edge_radius
-        )
+        return self._distance(p)[0]
+
+    def phi_normal_local(self, p):
+        """``(phi, outward unit normal)`` of one point (3,), the gradient in closed form."""
+        return revolved_normal(p, *self._distance(p))
 
 
 def _check_plate(owner, opening, radius, thickness, radius_name):
@@ -391,7 +389,7 @@ class GridSDF:
 
 
 def _phi_normal_one(tool, p):
-    if isinstance(tool, GridSDF):
+    if hasattr(tool, "phi_normal_local"):  # closed-form (the punch and plates) or sampled (GridSDF) normals
         return tool.phi_normal_local(p)
     phi, g = jax.value_and_grad(tool.phi_local)(p)
     return phi, safe_normalize(g)

@@ -17,7 +17,7 @@ import jax
 import jax.numpy as jnp
 import numpy as np
 
-from jaxform import forming
+from jaxform import forming, integrate
 from jaxform.batching import BATCH_AXIS, cores
 from jaxform.calibrate import sections as sec_mod
 from jaxform.calibrate.imperfections import imperfections
@@ -58,13 +58,13 @@ def _member(q, dz, rig, lines, static):
     return y, jnp.concatenate(oks), (s.bad_step < 0) & jnp.all(jnp.isfinite(y)), reach
 
 
-@functools.partial(jax.jit, static_argnames=("static",))
+@functools.partial(jax.jit, static_argnames=("static",), compiler_options=integrate.COMPILER_OPTIONS)
 def _batch(Q, Z, rig, lines, static):
     """:func:`_member` over a batch (one compiled program per rig shape, shared by every fit in a process)."""
     return jax.vmap(lambda q, dz: _member(q, dz, rig, lines, static), axis_name=BATCH_AXIS)(Q, Z)
 
 
-@functools.partial(jax.jit, static_argnames=("static",))
+@functools.partial(jax.jit, static_argnames=("static",), compiler_options=integrate.COMPILER_OPTIONS)
 def _grad(q, dz, rig, lines, R, meas, valid, static):
     """Gradient of ``0.5 |R (y - meas)|^2`` (``y`` masked by ``valid``), checkpointed reverse mode."""
     def loss(q):

@@ -300,7 +300,7 @@ def _program(tree_def, axes: tuple, devices: tuple, n_plies: int):
                                   is_leaf=lambda a: a is None)
     row = P(MESH_AXIS)
     return jax.jit(jax.shard_map(batched, mesh=mesh, in_specs=(spec, row, row, row, row, P(), P()), out_specs=row,
-                                 check_vma=False))
+                                 check_vma=False), compiler_options=integrate.COMPILER_OPTIONS)
 
 
 def _host(tree):

@@ -15,6 +15,7 @@ penetrated too deep an automatic contact, with the contact stiffened as well.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import time
 from typing import Any, Callable
@@ -64,7 +65,7 @@ def run_steps(model, state, e0, x_ref, n: int, energy_floor: float | None = None
     return integrate.run_steps(model, state, n, e0=e0, x_ref=x_ref, blowup_tol=BLOWUP_TOL, energy_floor=floor)[0]
 
 
-@jax.jit
+@functools.partial(jax.jit, compiler_options=integrate.COMPILER_OPTIONS)
 def _advance_jit(model, state, e0, x_ref, n, energy_floor):
     """The host driver's stretch of ``n`` steps (traced: one program for a rig, whatever its
     stroke, frame count or sampling), forward only (:func:`jaxform.integrate.advance`)."""

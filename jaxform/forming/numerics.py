@@ -26,7 +26,10 @@ NLBM at 4 mm (``benchmarks/results/fibre-springs-20261207``) with 24 blew up at 
 without the momentum term and at 35 and 48 mm with it (the step cut to 1/8 did not save it), and
 with 48 at 17 mm, then needed the term, step cuts to 1/8 and the contact 64x stiffer to finish,
 9.7 deg (p95) from the run with 12; the products a larger factor costs would have bought at most
-2.3x fewer steps' time at 2 mm."""
+2.3x fewer steps' time at 2 mm. Measured again with the contact the numerics now choose at 24 (its
+normal forces backward, as stiff as with 12; ``benchmarks/results/step-pieces-20261207``): the
+energy balance failed at 27.2 mm without the term and at 34.2 mm with it, the contact went 64x
+stiffer, KE/IE 0.23, the symmetry lost, and it took twice as long as with 12 (308 s against 149 s)."""
 FIBRE_MASS_MAX_OFF_AXIS = 3.0
 """The largest automatic factor for plies whose fibres run off the blank's edges (more than 10
 degrees, e.g. the +-45 deg NCF). Their corners are held in-plane by shear alone and whip, and the

@@ -53,7 +53,7 @@ from jaxform.spectrum import stable_time_step
 
 COMPILER_OPTIONS = {"xla_cpu_experimental_ynn_fusion_type": ""}
 """XLA options of the programs that run the step (the forming driver's, a batch's, the section
-fits'): no YNNPACK fusions on CPU. This XLA hands the step's reductions (the three-row dot products,
+fits', :func:`simulate`'s): no YNNPACK fusions on CPU. This XLA hands the step's reductions (the three-row dot products,
 the energies' sums) to YNNPACK, one library call each, outside XLA's own loop fusions; without
 them the 2 mm woven step took 6.7-7.1 ms against 8.3-8.5 ms (the same sums in another order:
 positions within 1.1e-6 m after 2,000 steps; ``benchmarks/results/step-pieces-20261207``)."""
@@ -426,12 +426,17 @@ def check(state: State, frames: Frames, model: Model):
                           state=state)
 
 
+_rollout_jit = jax.jit(rollout, static_argnames=("n_frames", "every", "checkpoint", "blowup_tol"),
+                       compiler_options=COMPILER_OPTIONS)
+"""One jitted :func:`rollout` for :func:`simulate`: calls with the same model structure and shapes share its
+program (a ``jax.jit`` made inside ``simulate`` compiled again on every call)."""
+
+
 def simulate(model: Model, state: State | None = None, *, n_frames: int, every: int, checkpoint: bool = True,
              blowup_tol: float = 0.5):
     """Host driver: jit + run + health check. Returns ``(final_state, frames)``."""
     state = init_state(model) if state is None else state
-    fn = jax.jit(rollout, static_argnames=("n_frames", "every", "checkpoint", "blowup_tol"), compiler_options=COMPILER_OPTIONS)
-    s, frames = fn(model, state, n_frames=n_frames, every=every, checkpoint=checkpoint, blowup_tol=blowup_tol)
+    s, frames = _rollout_jit(model, state, n_frames=n_frames, every=every, checkpoint=checkpoint, blowup_tol=blowup_tol)
     check(s, frames, model)
     return s, frames
 

@@ -35,7 +35,33 @@ def regularised_friction(v_t, normal_force, mu, eps_v):
     return -mu * normal_force * v_t / jnp.sqrt(jnp.sum(v_t * v_t, axis=0) + eps_v * eps_v)
 
 
-FRICTION_ITERATIONS = 12  # Newton steps of backward_friction: within 1e-6 of mu F_n where a / eps_v <= 1e5
+FRICTION_ITERATIONS = 12
+"""The most Newton steps :func:`backward_friction` takes (it stops before, :data:`FRICTION_RTOL`):
+from its start (:func:`_slip_from_below`) float32 Newton is within 1e-6 of the force from
+``a / eps_v = 1e-3`` to ``1e5`` and ``u* / a = 1e-3`` to ``1e3`` after 4 steps."""
+FRICTION_RTOL = 16.0
+"""Newton stops once no node's slip moves by more than this many units of roundoff
+(``jnp.finfo(dtype).eps``) of itself. A converged float32 iteration still steps between two
+neighbouring numbers on a few nodes (woven Case A at 4 mm: 2 to 7 nodes at each step sampled),
+so an exact fixed point, the stop before, was never reached and the loop ran all its steps; near
+the root Newton doubles the digits it has each step, so what this stop leaves is roundoff."""
+
+
+def _slip_from_below(u_star, a, eps):
+    """A lower bound of the end-of-step slip ``u`` of :func:`backward_friction`, close to it in every
+    regime (arrays of one shape, m/s): the largest of ``u* - a`` (sliding: the force is below
+    ``mu F_n``), ``u* / (1 + a / eps)`` (stick: the law's slope is at most ``mu F_n / eps``) and,
+    where the residual is not positive there, ``0.7 eps C sqrt(C / (C + D))`` with ``C = (a /
+    (2 eps))**(1/3)`` and ``D = (a - u*) / eps`` (near ``u* = a``, where the other two are far
+    below the root: ``1 - u / r >= eps**2 / (2 r**2)`` bounds the root from below by that of
+    ``(U + D) (U**2 + 1) = C**3`` in ``U = u / eps``, ``C`` at ``D = 0`` and ``C sqrt(C / D)`` for
+    ``D >> C``). From ``max(u* - a, 0)`` alone float32 Newton needed 11 steps at ``u* = a`` and
+    ``a / eps = 1e5``; from this, 4 over ``a / eps = 1e-3 .. 1e5`` and ``u* / a = 1e-3 .. 1e3``."""
+    below = jnp.maximum(u_star - a, u_star / (1.0 + a / eps))
+    c = jnp.cbrt(0.5 * a / eps)
+    near = jnp.minimum(0.7 * eps * c * jnp.sqrt(c / jnp.maximum(c + (a - u_star) / eps, 1e-3 * c)), u_star)
+    ok = near + a * near / jnp.sqrt(near * near + eps * eps) <= u_star
+    return jnp.clip(jnp.where(ok, jnp.maximum(below, near), below), 0.0, u_star)
 
 
 def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
@@ -43,9 +69,11 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
 
     With ``u*`` the tangential slip speed the trial momentum implies (``(p - m w)_t / m``) and
     ``a = h mu F_n / m`` (the speed friction can remove in the step), the end-of-step slip speed
-    ``u`` solves ``u + a u / sqrt(u**2 + eps_v**2) = u*`` (Newton from ``max(u* - a, 0)``, at most
-    :data:`FRICTION_ITERATIONS` steps, fewer once a step changes no node; converging from below:
-    the force never exceeds ``mu F_n`` and never reverses the slip). The force is the law at ``u``:
+    ``u`` solves ``u + a u / sqrt(u**2 + eps_v**2) = u*`` (Newton from the lower bound of
+    :func:`_slip_from_below` until no node's ``u`` moves by more than :data:`FRICTION_RTOL` units of
+    roundoff of it, at most :data:`FRICTION_ITERATIONS` steps; the left side is concave in ``u``, so
+    Newton converges from below: the force never exceeds ``mu F_n`` and never reverses the slip).
+    The force is the law at ``u``:
     ``-mu F_n u / sqrt(u**2 + eps_v**2)`` along the trial slip. ``eps_v -> 0`` is Coulomb's return
     mapping ``u = max(u* - a, 0)``.
 
@@ -76,21 +104,21 @@ def backward_friction(p, mass, h, f_normal, mu, eps_v, velocity):
     def residual(u):
         return u + a * u / jnp.sqrt(u * u + eps * eps) - u_star
 
+    rtol = FRICTION_RTOL * jnp.finfo(p.dtype).eps
+
     def solve(g, u0):
         def newton(c):
             i, u, _ = c
             r = jnp.sqrt(u * u + eps * eps)
             un = jnp.clip(u - g(u) / (1.0 + a * eps * eps / (r * r * r)), 0.0, u_star)
-            return i + 1, un, jnp.any(un != u)
+            return i + 1, un, jnp.any(jnp.abs(un - u) > rtol * un)
 
-        # stops early once a step changes no node's u (a fixed point of the rounded iteration: the
-        # steps after it would change nothing either), else after FRICTION_ITERATIONS steps
         go = lambda c: (c[0] < FRICTION_ITERATIONS) & c[2]  # noqa: E731
         return jax.lax.while_loop(go, newton, (0, u0, jnp.asarray(True)))[1]
 
     # derivatives by the implicit function theorem at the root (one scalar equation per node: the
     # tangent solve divides by dg/du), not through the Newton loop: a lighter reverse program
-    u = jax.lax.custom_root(residual, jnp.maximum(u_star - a, 0.0), solve,
+    u = jax.lax.custom_root(residual, _slip_from_below(u_star, a, eps), solve,
                             lambda g, y: y / g(jnp.ones_like(y)))
     mag = mu * fn * u / jnp.sqrt(u * u + eps * eps)
     force = -mag * safe_normalize(qt, fallback=jnp.zeros(3, p.dtype), axis=0)
@@ -126,4 +154,4 @@ def backward_pair_friction(p, mass, h, slave, master_nodes, w, f_normal, mu, eps
     return backward_friction(m_pair[:, None] * v_rel, m_pair, h, f_normal, mu, eps_v, jnp.zeros(3, p.dtype))
 
 
-__all__ = ["regularised_friction", "backward_friction", "backward_pair_friction", "FRICTION_ITERATIONS"]
+__all__ = ["regularised_friction", "backward_friction", "backward_pair_friction", "FRICTION_ITERATIONS", "FRICTION_RTOL"]

@@ -348,6 +348,47 @@ def test_backward_friction_solves_the_regularised_law_at_the_end_of_step_slip():
     np.testing.assert_allclose(g[1:], fd[1:], rtol=1e-5)
 
 
+def test_backward_friction_in_float32_is_converged_over_both_regimes_within_a_few_newton_steps():
+    """float32 :func:`friction.backward_friction` over ``a / eps_v = 1e-3 .. 1e5`` and ``u* / a =
+    1e-3 .. 1e3`` (stick, the transition, slip) against the root in float64 (bisection): the force
+    within 1e-6 of ``mu F_n`` and of itself; and the start (``_slip_from_below``) is a lower bound
+    from which 4 float32 Newton steps already give that (the loop stops on its own, not at its cap:
+    the same result with the cap at 4)."""
+    a_over_eps, s_over_a = np.meshgrid(np.logspace(-3, 5, 81), np.r_[np.logspace(-3, 3, 61), np.linspace(0.9, 1.1, 41)])
+    m, h, mu, fn, eps = 2e-5, 1e-5, 0.23, 1e-2, 1e-4
+    a = h * mu * fn / m
+    eps = a / a_over_eps.ravel()  # one eps_v a node here: a call per eps, vectorised by vmap
+    us = (a * s_over_a).ravel()
+    n = us.size
+    lo, hi = np.zeros(n), us.copy()
+    for _ in range(200):  # the root in float64
+        mid = 0.5 * (lo + hi)
+        neg = mid + a * mid / np.hypot(mid, eps) - us < 0
+        lo, hi = np.where(neg, mid, lo), np.where(neg, hi, mid)
+    u = 0.5 * (lo + hi)
+    ref = mu * fn * u / np.hypot(u, eps)
+    p = np.zeros((n, 3), np.float32)
+    p[:, 0] = m * us
+    f_normal = np.tile(np.float32([0.0, 0.0, fn]), (n, 1))
+    one = jax.jit(jax.vmap(lambda pi, ei: friction.backward_friction(pi[None], jnp.full(1, m, jnp.float32), h,
+                                                                     f_normal[:1], mu, ei, jnp.zeros(3, jnp.float32))[0][0, 0]))
+    pj, ej = jnp.asarray(p), jnp.asarray(eps, jnp.float32)
+    got = -np.asarray(one(pj, ej), np.float64)
+    assert got.dtype == np.float64 and np.asarray(one(pj, ej)).dtype == np.float32
+    np.testing.assert_allclose(got, ref, rtol=1e-6, atol=1e-6 * mu * fn)
+    start = np.asarray(friction._slip_from_below(jnp.asarray(us, jnp.float32), jnp.float32(a), ej), np.float64)
+    assert np.all(start <= u * (1 + 1e-6) + 1e-30)
+    cap = friction.FRICTION_ITERATIONS
+    try:
+        friction.FRICTION_ITERATIONS = 4
+        capped = -np.asarray(jax.jit(jax.vmap(lambda pi, ei: friction.backward_friction(
+            pi[None], jnp.full(1, m, jnp.float32), h, f_normal[:1], mu, ei, jnp.zeros(3, jnp.float32))[0][0, 0]))(pj, ej),
+            np.float64)
+    finally:
+        friction.FRICTION_ITERATIONS = cap
+    np.testing.assert_allclose(capped, ref, rtol=1e-6, atol=1e-6 * mu * fn)
+
+
 def test_backward_pair_friction_conserves_momentum_stops_a_stuck_pair_and_slides_at_coulomb():
     """Ply on ply, integrated backward (:func:`friction.backward_pair_friction`): the pair forces sum
     to zero; a sliding pair feels ``mu F_n`` against its relative slip; a node resting on a node

@@ -1,5 +1,8 @@
 """``jaxform run``: outputs, refusal of a user's directory, interrupted and failed runs (coarse mesh)."""
 import json
+import os
+import subprocess
+import sys
 import xml.etree.ElementTree as ET
 
 import meshio
@@ -120,6 +123,21 @@ def test_a_run_normalises_its_case_and_builds_its_rig_once(tmp_out, monkeypatch)
     assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST, "--set", "process.frames=2"]) == 0
     assert calls == {"tools": 1, "mesh": 1, "load": 1}
 
+
+
+def test_a_float64_case_runs_from_the_command_line(tmp_out):
+    """``numerics.dtype = "float64"`` from the command line, in a process whose JAX is not in 64-bit
+    mode (this test session's is): the command switches it on (:func:`jaxform.cli.use_case_dtype`);
+    before, the run stopped with advice to call ``jax.config.update``, which a command line user
+    cannot take. The frames carry float64 positions (not all of them float32 numbers)."""
+    env = {k: v for k, v in os.environ.items() if k != "JAX_ENABLE_X64"}
+    r = subprocess.run([sys.executable, "-m", "jaxform.cli", "run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST,
+                        "--set", "numerics.dtype=float64"], capture_output=True, text=True, env=env, timeout=600)
+    assert r.returncode == 0, r.stderr
+    s = json.loads((tmp_out / "summary.json").read_text())
+    assert s["complete"] and s["inputs"]["numerics"]["dtype"] == "float64"
+    x = meshio.read(tmp_out / _pvd_files(tmp_out)[-1][1]).points
+    assert x.dtype == np.float64 and np.any(x.astype(np.float32).astype(np.float64) != x)
 
 def test_run_refuses_a_users_directory(tmp_out, capsys):
     tmp_out.mkdir()

@@ -35,6 +35,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def use_case_dtype(case) -> None:
+    """The command owns its process: a case computed in float64 (``numerics.dtype = "float64"``)
+    switches JAX's 64-bit mode on before its rig is built. The library only checks that the mode is
+    on (:func:`jaxform.forming.build`), since switching it is the program's choice, which a command
+    line user could not make."""
+    if getattr(case, "dtype", "float32") == "float64":
+        import jax
+
+        jax.config.update("jax_enable_x64", True)
+
+
 TERMINATED = "terminated by SIGTERM"
 """The reason a run stopped by ``kill`` or a scheduler records (the command exits 143)."""
 

@@ -76,10 +76,12 @@ def execute(case, out, *, force=False, quiet=False, stream=None, element_size=No
     or interrupted run: the result says ``complete=False`` and why.
     """
     from jaxform import cases, forming
+    from jaxform.cli import use_case_dtype
     from jaxform.io.frames import FrameWriter, write_json
     from jaxform.io.output import prepare_output_dir
 
     case = cases.resolve(case, element_size=element_size, overrides=overrides)
+    use_case_dtype(case)
     out = prepare_output_dir(out, force=force, owner=owner, replaces=OUTPUTS)
     summary_path = out / "summary.json"
     t0 = time.perf_counter()

@@ -262,6 +262,7 @@ def run_members(base, overrides, dirs, *, quiet: bool = False, on_result=None, l
 
 def run(args) -> int:
     from jaxform import cases
+    from jaxform.cli import use_case_dtype
     from jaxform.io.output import prepare_output_dir
 
     vary = parse_vary(args.vary)
@@ -274,7 +275,7 @@ def run(args) -> int:
     combos = list(itertools.product(*[v for _, v in vary]))
     overrides = [[f"{k}={v}" for (k, _), v in zip(vary, combo)] for combo in combos]
     for ov in overrides:  # every member's input checked before anything is written
-        cases.apply_overrides(base, ov)
+        use_case_dtype(cases.apply_overrides(base, ov))
     names = member_names(vary, combos)
     out = args.out
     if pid == 0:

@@ -177,27 +177,50 @@ def _with_derivative(f, x):
     return w, dw.astype(x.dtype)
 
 
-def _membrane_terms(e1, e2, shell: Shell, t0: int, t1: int, fab):
-    """``(coef, g1, g2, lambda1, lambda2, (E h) per family, area, tension energy)`` of ply triangles ``t0:t1``."""
+def _fibres_and_strains(e1, e2, coef, base=None):
+    """``(g1, g2, lambda1, lambda2, lambda1 - 1, lambda2 - 1)`` of triangles: fibre vectors (3, T)
+    and stretches and strains (T,), from their edges ``e1, e2`` (3, T) or, with ``base`` (the
+    reference edges (2, 3, T)), from the edges' changes from the reference.
+
+    From the fibre vectors alone (no ``base``) the strain ``|g| - 1`` keeps only the digits above
+    ``|g|``'s rounding: about 6e-8 in float32, against fibre strains of 1e-5 to 1e-3, a noise that
+    the stiff fibre tension turns into forces every step. That noise was what gave a float32 run
+    more kinetic energy than float64 (woven Case A at 8 mm: peak KE/IE 0.10 against 0.058, and the
+    same 0.10 in float64 with only ``|g|`` rounded to float32; README, issue 13). From the changes,
+    the fibre vector's change ``dg`` is known apart from ``g = g0 + dg`` (``g0`` the unit reference
+    fibre), and ``lambda**2 - 1 = 2 g0 . dg + dg . dg = (2 g - dg) . dg`` has no cancellation: the
+    strain ``(lambda**2 - 1) / (lambda + 1)`` to the roundoff of itself."""
+    if base is None:
+        g1, g2 = _fibres_soa(e1, e2, coef)
+        l1, l2 = _stretch(g1), _stretch(g2)
+        return g1, g2, l1, l2, l1 - 1.0, l2 - 1.0
+    d1, d2 = _fibres_soa(e1, e2, coef)
+    r1, r2 = _fibres_soa(base[0].astype(e1.dtype), base[1].astype(e1.dtype), coef)
+    g1, g2 = r1 + d1, r2 + d2
+    l1, l2 = _stretch(g1), _stretch(g2)
+    return g1, g2, l1, l2, _dot(2.0 * g1 - d1, d1) / (l1 + 1.0), _dot(2.0 * g2 - d2, d2) / (l2 + 1.0)
+
+
+def _membrane_terms(e1, e2, shell: Shell, t0: int, t1: int, fab, base=None):
+    """``(coef, g1, g2, lambda1, lambda2, strain1, strain2, (E h) per family, area, tension energy)``
+    of ply triangles ``t0:t1`` (``base``: :func:`_fibres_and_strains`)."""
     ref = shell.ref
     dtype = e1.dtype
     coef = ref.tri_coef[t0:t1].astype(dtype)
-    g1, g2 = _fibres_soa(e1, e2, coef)
-    l1 = _stretch(g1)
-    l2 = _stretch(g2)
+    g1, g2, l1, l2, s1, s2 = _fibres_and_strains(e1, e2, coef, base)
     eh = jnp.broadcast_to(jnp.asarray(fab.fibre_modulus * fab.thickness, dtype), (2,))
     a = ref.tri_area[t0:t1].astype(dtype)
-    return coef, g1, g2, l1, l2, eh, a, 0.5 * a * (eh[0] * (l1 - 1.0) ** 2 + eh[1] * (l2 - 1.0) ** 2)
+    return coef, g1, g2, l1, l2, s1, s2, eh, a, 0.5 * a * (eh[0] * s1 ** 2 + eh[1] * s2 ** 2)
 
 
-def _membrane_density(e1, e2, shell: Shell, t0: int, t1: int, fab):
+def _membrane_density(e1, e2, shell: Shell, t0: int, t1: int, fab, base=None):
     """Membrane energy per triangle (J) of ply triangles ``t0:t1`` from SoA edges (3, T): (tension, shear)."""
-    _, g1, g2, _, _, _, a, tension = _membrane_terms(e1, e2, shell, t0, t1, fab)
+    _, g1, g2, _, _, _, _, _, a, tension = _membrane_terms(e1, e2, shell, t0, t1, fab, base)
     gamma = shell.ref.theta0[t0:t1].astype(e1.dtype) - _angle(g1, g2)
     return tension, a * _shear_energy(fab.shear, gamma, shell.shear_reading)
 
 
-def _membrane_gradient(e1, e2, shell: Shell, t0: int, t1: int, fab, wt, ws):
+def _membrane_gradient(e1, e2, shell: Shell, t0: int, t1: int, fab, wt, ws, base=None):
     """``(tension, shear, dE/de1, dE/de2)`` of ply triangles ``t0:t1``, ``E = wt tension + ws shear``:
     the closed form of ``jax.grad`` of :func:`_membrane_density` (tested against it; half its time).
 
@@ -205,14 +228,14 @@ def _membrane_gradient(e1, e2, shell: Shell, t0: int, t1: int, fab, wt, ws):
     ``d theta / d g1 = (d g2 x c - s g2) / (s² + d²)``, ``d theta / d g2 = (d c x g1 - s g1) / (s² + d²)``
     (``c`` the unit cross product; both vanish with ``s``, as autodiff's do); ``g_f = e1 coef[f, 0] + e2 coef[f, 1]``.
     """
-    coef, g1, g2, l1, l2, eh, a, tension = _membrane_terms(e1, e2, shell, t0, t1, fab)
+    coef, g1, g2, l1, l2, s1, s2, eh, a, tension = _membrane_terms(e1, e2, shell, t0, t1, fab, base)
     theta, cr, s, d = _angle_terms(g1, g2)
     w, dw = _with_derivative(lambda g: _shear_energy(fab.shear, g, shell.shear_reading),
                              shell.ref.theta0[t0:t1].astype(e1.dtype) - theta)
     ch = cr / jnp.maximum(s, jnp.finfo(s.dtype).tiny)
     ts = -ws * a * dw / (s * s + d * d)  # dE/dtheta / (s² + d²): gamma = theta0 - theta
-    G1 = (wt * a * eh[0] * (l1 - 1.0) / l1) * g1 + ts * (d * _cross(g2, ch) - s * g2)
-    G2 = (wt * a * eh[1] * (l2 - 1.0) / l2) * g2 + ts * (d * _cross(ch, g1) - s * g1)
+    G1 = (wt * a * eh[0] * s1 / l1) * g1 + ts * (d * _cross(g2, ch) - s * g2)
+    G2 = (wt * a * eh[1] * s2 / l2) * g2 + ts * (d * _cross(ch, g1) - s * g1)
     dtype = e1.dtype  # the weights may be wider (cotangents of the energies): gradients in the edges' dtype, as autodiff's
     return (tension, a * w, (G1 * coef[:, 0, 0] + G2 * coef[:, 1, 0]).astype(dtype),
             (G1 * coef[:, 0, 1] + G2 * coef[:, 1, 1]).astype(dtype))
@@ -254,16 +277,20 @@ def _bending_gradient(D, shell: Shell, n0: int, n1: int, fab, wb):
     return energy, jnp.stack(G).astype(dtype)
 
 
-def _local_energy(e1, e2, D, shell: Shell, weights=None):
-    """``(sum_k w_k E_k, parts)`` from the edges and node derivatives; ``weights`` (tension, shear,
-    bending) default to 1 (the total energy)."""
+def _ply_base(base, t0, t1):
+    return None if base is None else base[:, :, t0:t1]
+
+
+def _local_energy(e1, e2, D, shell: Shell, weights=None, base=None):
+    """``(sum_k w_k E_k, parts)`` from the edges (with ``base``: their changes from it, :func:`_kinematics`)
+    and node derivatives; ``weights`` (tension, shear, bending) default to 1 (the total energy)."""
     mesh = shell.mesh
     dtype = e1.dtype
     tension = jnp.zeros((), dtype)
     shear = jnp.zeros((), dtype)
     bending = jnp.zeros((), dtype)
     for (t0, t1), (n0, n1), fab in zip(mesh.ply_tris, mesh.ply_nodes, shell.fabrics):
-        wt, ws = _membrane_density(e1[:, t0:t1], e2[:, t0:t1], shell, t0, t1, fab)
+        wt, ws = _membrane_density(e1[:, t0:t1], e2[:, t0:t1], shell, t0, t1, fab, _ply_base(base, t0, t1))
         tension = tension + jnp.sum(wt)
         shear = shear + jnp.sum(ws)
         if fab.bending is not None:
@@ -275,7 +302,7 @@ def _local_energy(e1, e2, D, shell: Shell, weights=None):
     return wt * tension + ws * shear + wb * bending, parts
 
 
-def _local_gradients(e1, e2, D, shell: Shell, weights=None):
+def _local_gradients(e1, e2, D, shell: Shell, weights=None, base=None):
     """``(parts, (dE/de1, dE/de2, dE/dD or None))`` of ``E = sum_k w_k E_k``: what ``jax.value_and_grad``
     of :func:`_local_energy` gives, in closed form (:func:`_membrane_gradient`, :func:`_bending_gradient`)."""
     mesh = shell.mesh
@@ -283,7 +310,8 @@ def _local_gradients(e1, e2, D, shell: Shell, weights=None):
     parts = {k: jnp.zeros((), e1.dtype) for k in ("tension", "shear", "bending")}
     g1, g2, gD = [], [], []
     for (t0, t1), (n0, n1), fab in zip(mesh.ply_tris, mesh.ply_nodes, shell.fabrics):
-        et, es, a, b = _membrane_gradient(e1[:, t0:t1], e2[:, t0:t1], shell, t0, t1, fab, wt, ws)
+        et, es, a, b = _membrane_gradient(e1[:, t0:t1], e2[:, t0:t1], shell, t0, t1, fab, wt, ws,
+                                          _ply_base(base, t0, t1))
         parts["tension"], parts["shear"] = parts["tension"] + jnp.sum(et), parts["shear"] + jnp.sum(es)
         g1.append(a)
         g2.append(b)
@@ -308,16 +336,19 @@ def energy_parts(x, shell: Shell):
 
 
 def _kinematics(xs, shell: Shell, displacement: bool):
-    """Edges and node derivatives (``None`` without bending) from positions, or from
-    displacements from the reference (``displacement``)."""
+    """``(e1, e2, D, base)``: the triangles' edges and the node derivatives (``None`` without bending)
+    from positions (``base`` None), or from displacements from the reference (``displacement``):
+    then ``e1, e2`` are the edges' changes and ``base`` the reference edges (2, 3, T), from which the
+    fibre strains are exact to their own roundoff (:func:`_fibres_and_strains`)."""
     ref, mesh = shell.ref, shell.mesh
-    e1, e2 = _edges(xs, mesh, ref.edge0 if displacement else None)
+    e1, e2 = _edges(xs, mesh)
     D = _derivs_soa(xs, mesh, ref.deriv0 if displacement else None) if _has_bending(shell) else None
-    return e1, e2, D
+    return e1, e2, D, (ref.edge0 if displacement else None)
 
 
 def _parts_soa(xs, shell: Shell, displacement: bool = False):
-    return _local_energy(*_kinematics(xs, shell, displacement), shell)[1]
+    e1, e2, D, base = _kinematics(xs, shell, displacement)
+    return _local_energy(e1, e2, D, shell, base=base)[1]
 
 
 def energy(x, shell: Shell):
@@ -349,8 +380,8 @@ def forces_and_energy_soa(xs, shell: Shell, weights=None, displacement: bool = F
     """
     mesh = shell.mesh
     has_b = _has_bending(shell)
-    e1, e2, D = _kinematics(xs, shell, displacement)
-    parts, (g1, g2, gD) = _local_gradients(e1, e2, D, shell, weights)
+    e1, e2, D, base = _kinematics(xs, shell, displacement)
+    parts, (g1, g2, gD) = _local_gradients(e1, e2, D, shell, weights, base)
     grad_s = assemble_corners(jnp.concatenate([-(g1 + g2), g1, g2], axis=1), mesh)  # dE/dx of the corners
     if has_b:
         H = _derivs_transpose(gD, mesh)  # (3, K, N) dE/d(x_nbr_k - x_i)

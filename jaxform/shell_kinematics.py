@@ -49,14 +49,11 @@ def _stretch(g):
 # CPU, where (n, 3) layouts with tiny trailing axes do not (measured: 5-10x).
 
 
-def _edges(xs, mesh: Mesh, base=None):
-    """Triangle edge vectors ``x1 - x0``, ``x2 - x0`` (3, T) each; plus ``base`` (2, 3, T) if given."""
+def _edges(xs, mesh: Mesh):
+    """Triangle edge vectors ``x1 - x0``, ``x2 - x0`` (3, T) each (of displacements: the edges' changes)."""
     t = mesh.tris
     x0 = xs[:, t[:, 0]]
-    e1, e2 = xs[:, t[:, 1]] - x0, xs[:, t[:, 2]] - x0
-    if base is None:
-        return e1, e2
-    return e1 + base[0].astype(xs.dtype), e2 + base[1].astype(xs.dtype)
+    return xs[:, t[:, 1]] - x0, xs[:, t[:, 2]] - x0
 
 
 def _fibres_soa(e1, e2, coef):

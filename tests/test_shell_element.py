@@ -66,6 +66,45 @@ def test_assembled_forces_equal_minus_energy_gradient(fabric):
     np.testing.assert_allclose(np.asarray(f), -np.asarray(g), rtol=1e-9, atol=1e-9 * float(jnp.max(jnp.abs(g))))
 
 
+
+def test_float32_fibre_strains_from_displacements_are_exact_to_their_own_roundoff():
+    """Fibre tension forces in float32 from displacements (the integrator's path): the strain comes
+    from the edges' displacement parts (``2 g0 . dg + dg . dg``, no cancellation), so on a blank
+    carried 50 mm with fibre strains of about 1e-4 the float32 forces match float64's on the same
+    (float32) displacements to 1e-5 of their largest; from the fibre vectors' lengths (``|g| - 1``,
+    the positions' path, and the displacement path before) they miss by more than 1e-4 (the
+    strain's 6e-8 rounding)."""
+    import jaxform.shell as S
+
+    mesh = Mesh.rectangle(0.04, 0.03, 0.004)
+    shell = Shell.build(mesh, WOVEN_38616)
+    X = np.asarray(mesh.nodes)
+    rng = np.random.default_rng(5)
+    strain = 1e-4 * (1.0 + 0.5 * rng.normal(size=(2, 2)))
+    u = np.zeros_like(X)
+    u[:, :2] = X[:, :2] @ strain.T + np.array([0.05, -0.03])  # uniform stretch, carried 50 mm
+    u[:, 2] = 2e-4 * np.sin(60.0 * X[:, 0])  # and a gentle wave out of plane
+    w = (1.0, 0.0, 0.0)  # the tension alone
+
+    def tension_forces(us, exact):
+        e1, e2, D, base = S._kinematics(us, shell, True)
+        if exact:
+            return S._local_gradients(e1, e2, D, shell, w, base)[1][:2]
+        b = jnp.asarray(base, us.dtype)  # the whole edges, as from positions
+        return S._local_gradients(e1 + b[0], e2 + b[1], D, shell, w)[1][:2]
+
+    u32 = jnp.asarray(u.T, jnp.float32)  # float64 gets the same (rounded) displacements: the arithmetic compared
+    want = [np.asarray(g, np.float64) for g in tension_forces(u32.astype(jnp.float64), True)]
+    scale = max(np.max(np.abs(g)) for g in want)
+    for exact, bound in ((True, 1e-5), (False, None)):
+        got = tension_forces(u32, exact)
+        assert got[0].dtype == jnp.float32
+        err = max(np.max(np.abs(np.asarray(g, np.float64) - h)) for g, h in zip(got, want)) / scale
+        if exact:
+            assert err < bound, err
+        else:
+            assert err > 1e-4, err  # the test would see the old strain's noise
+
 def _stack_shell():
     """Two plies at 0 and 45 degrees, the top one membrane-only (a ply without bending beside one with)."""
     mesh = Mesh.rectangle(0.03, 0.02, 0.005, plies=2, ply_spacing=0.001)
@@ -89,7 +128,7 @@ def test_closed_form_local_gradients_equal_autodiff(make):
     rng = np.random.default_rng(5)
     u = jnp.stack([0.7 * X[:, 1] * jnp.sign(X[:, 0] - 0.015), 0.0 * X[:, 1], 8.0 * (X[:, 0] - 0.015) ** 2], axis=1)
     xs = (X + u + 2e-4 * jnp.asarray(rng.normal(size=X.shape))).T
-    e1, e2, D = S._kinematics(xs, shell, False)
+    e1, e2, D, _ = S._kinematics(xs, shell, False)
     w = (0.3, -0.7, 1.3)
     (_, parts_ad), g_ad = jax.value_and_grad(S._local_energy, argnums=(0, 1, 2), has_aux=True)(e1, e2, D, shell, w)
     parts, g = jax.jit(lambda a, b, c: S._local_gradients(a, b, c, shell, w))(e1, e2, D)
@@ -108,7 +147,7 @@ def test_closed_form_gradients_keep_the_kinematics_dtype():
 
     shell = Shell.build(_curved_sheared_mesh(), NCF_FCIM359)
     xs = (jnp.asarray(shell.mesh.nodes) * 1.01).T.astype(jnp.float32)
-    e1, e2, D = S._kinematics(xs, shell, False)
+    e1, e2, D, _ = S._kinematics(xs, shell, False)
     w = tuple(jnp.asarray(v, jnp.float64) for v in (0.3, -0.7, 1.3))
     (_, parts_ad), g_ad = jax.value_and_grad(S._local_energy, argnums=(0, 1, 2), has_aux=True)(e1, e2, D, shell, w)
     parts, g = S._local_gradients(e1, e2, D, shell, w)

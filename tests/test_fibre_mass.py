@@ -399,9 +399,11 @@ def _spun_ncf_rig():
 
 def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     """A forming run whose blank spins in-plane and stretches (NCF, 25 mm, fibre mass 12 without
-    its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792) is
-    run again from its start with it, the run completes, and the summary says from which step and
-    why. The same rig at rest never pays for the term. Batched: the slow test below."""
+    its term): the chunk that blows up without the term (measured: from step 1,422 of 3,792, its
+    energy balance failing; since the exact fibre strain, 698f81f, from step 1,419 of 3,784, a node
+    at 21 m/s tripping the speed bound first) is run again from its start with it, the run
+    completes, and the summary says from which step and why. The same rig at rest never pays for
+    the term. Batched: the slow test below."""
     from jaxform import forming
 
     calm_rig, spun_rig = _spun_ncf_rig()
@@ -410,7 +412,8 @@ def test_the_driver_turns_the_momentum_term_on_where_a_chunk_fails_without_it():
     res = forming.run(spun_rig, catch=True)
     assert res.complete, res.reason
     sw = res.momentum_term_from
-    assert sw is not None and 0 < sw["step"] < info.n_steps and "energy" in sw["cause"]
+    assert sw is not None and 0 < sw["step"] < info.n_steps
+    assert "energy" in sw["cause"] or "a node moves at" in sw["cause"]  # the blow-up, by whichever bound trips first
     assert res.model.fibre_mass.geometric
     n = res.summary["numerics"]
     assert n["fibre_mass_momentum_term"] and n["fibre_mass_momentum_term_from_step"] == sw["step"]

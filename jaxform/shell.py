@@ -226,7 +226,8 @@ def _membrane_gradient(e1, e2, shell: Shell, t0: int, t1: int, fab, wt, ws, base
 
     ``d lambda_f / d g_f = g_f / lambda_f``; ``theta = atan2(s, d)`` with ``s = |g1 x g2|``, ``d = g1 . g2``:
     ``d theta / d g1 = (d g2 x c - s g2) / (s² + d²)``, ``d theta / d g2 = (d c x g1 - s g1) / (s² + d²)``
-    (``c`` the unit cross product; both vanish with ``s``, as autodiff's do); ``g_f = e1 coef[f, 0] + e2 coef[f, 1]``.
+    (``c`` the unit cross product; both vanish with ``s``, as autodiff's do); ``g_f = e1 coef[f, 0] + e2 coef[f, 1]``
+    (with ``base``, the edges' changes: plus the reference's, :func:`_fibres_and_strains`; the derivatives are the same).
     """
     coef, g1, g2, l1, l2, s1, s2, eh, a, tension = _membrane_terms(e1, e2, shell, t0, t1, fab, base)
     theta, cr, s, d = _angle_terms(g1, g2)

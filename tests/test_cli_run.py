@@ -91,6 +91,7 @@ def test_verify_quasi_static_runs_half_the_speed_and_records_the_check(tmp_out, 
     verdict = c["shear_p95_deg"] < 1.0 and c["draw_in_edge_mid_rel"] < 0.02 and c["flange_wrinkles_diff"] == 0
     assert c["quasi_static"] is verdict
     assert rc == (0 if verdict else 3)
+    assert ("cause" in c) is (not verdict) and ("  why: " in text) is (not verdict)  # a failed check says why
     assert "quasi-static check against half the speed (250 mm/s" in text
     # along the stroke: each frame's shear difference, at the frames' punch travel (3 frames over 4 mm)
     per, depth = c["shear_p95_deg_per_frame"], c["punch_mm_per_frame"]
@@ -368,6 +369,24 @@ def test_report_flags_a_run_that_is_not_quasi_static_and_plots_name_case_and_pun
         head, doubt = fig.axes[0].get_title().split("\n")
         assert head.startswith("case-a-woven-nlbm:") and head.endswith("punch 4.0 mm"), head
         assert doubt == f"NOT quasi-static (KE/IE {ratio:.2g})", doubt
+
+
+def test_a_failed_quasi_static_check_says_whether_slower_would_help():
+    """A pair of runs that lost the case's half-turn symmetry (either of them) is path-dependent
+    buckling, where a slower run is not known to converge; a symmetric pair that differs is inertia."""
+    from jaxform.forming.summary import HALF_TURN_TOL, quasi_static_cause
+
+    kept = {"deviation": 0.01, "tolerance": HALF_TURN_TOL, "broken_between_punch_m": None}
+    lost = {"deviation": 0.9, "tolerance": HALF_TURN_TOL, "broken_between_punch_m": [0.0300, 0.0345]}
+    late = dict(lost, broken_between_punch_m=[0.040, 0.042])
+    assert quasi_static_cause(kept, kept)["kind"] == "inertia"
+    assert "halved" in quasi_static_cause(kept, kept)["text"]
+    assert "no symmetry to test" in quasi_static_cause(None, None)["text"]
+    for pair, who in (((lost, kept), "the run lost"), ((kept, lost), "the half-speed run lost"),
+                      ((late, lost), "the runs lost")):
+        cause = quasi_static_cause(*pair)
+        assert cause["kind"] == "path_dependent" and cause["text"].startswith(who), cause
+        assert "by 34.5 mm of punch travel" in cause["text"] and "not a converged answer" in cause["text"]
 
 
 def test_findings_say_what_speaks_against_a_result_and_the_report_prints_each():

@@ -180,6 +180,8 @@ def _report_check(check, stream):
         over = ", ".join(f"{v:.2f}° at {d:.1f} mm" for v, d in zip(per, depth) if v >= lim["shear_p95_deg"])
         print(f"  along the stroke: the shear maps part for good after {0.0 if to is None else to:.1f} mm of punch "
               f"travel; beyond {lim['shear_p95_deg']:g}°: {over}", file=stream)
+    if check.get("cause"):
+        print(f"  why: {check['cause']['text']}", file=stream)
 
 
 def report(result, written, out, stream=None):

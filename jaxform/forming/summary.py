@@ -363,9 +363,34 @@ def quasi_static_check(result, half) -> dict:
                                and out["draw_in_edge_mid_rel"] < lim["draw_in_edge_mid_rel"]
                                and out["flange_wrinkles_diff"] is not None
                                and out["flange_wrinkles_diff"] <= lim["flange_wrinkles_diff"])
+    if not out["quasi_static"]:
+        out["cause"] = quasi_static_cause(*(r.summary.get("half_turn_symmetry") for r in (result, half)))
     return out
 
 
+def quasi_static_cause(sym, sym_half) -> dict:
+    """Why two runs at a speed and its half differ, from their :func:`half_turn_symmetry` s
+    (``None`` where a case has none): ``kind`` and ``text`` (what it means and what to do).
+
+    ``"path_dependent"`` where either run lost the case's half-turn symmetry: its flange buckled
+    into one of several patterns the case does not tell apart, and a slower run is not known to
+    converge there (woven LBM B_inf at 8 mm, 62.5 to 7.8 mm/s at 698f81f: draw-in 28.6, 27.3,
+    27.5, 29.5 mm, each shear map 4.2-5.3 deg from the next slower one, symmetry lost in all four:
+    ``benchmarks/results/strain-fix-reruns-20261207/``); otherwise ``"inertia"``: the run is too fast."""
+    lost = [bool(s and s["deviation"] > s["tolerance"]) for s in (sym, sym_half)]
+    if any(lost):
+        at = min(1e3 * s["broken_between_punch_m"][1] for s, b in zip((sym, sym_half), lost) if b)
+        who = "runs" if all(lost) else "run" if lost[0] else "half-speed run"
+        return {"kind": "path_dependent", "text": (
+            f"the {who} lost the case's half-turn symmetry (by {at:.1f} mm of punch travel): the flange buckled into "
+            "one of several patterns the case does not tell apart, which a slower run is not known to settle (woven "
+            "LBM B_inf down to 1/8 of its automatic speed). Take the result as one of those patterns, not a converged "
+            "answer.")}
+    kept = "keep the case's symmetry and still differ" if sym and sym_half else "differ (the case has no symmetry to test)"
+    return {"kind": "inertia", "text": (
+        f"the two runs {kept}: most likely inertia shapes the result; run at process.speed_mm_per_s halved and "
+        "check again.")}
+
 __all__ = ["warning_kinds", "draw_in", "flange_mask", "flange_census", "symmetry_error", "mirror_index", "shear_mirror_odd", "summarize",
            "QUASI_STATIC_KE_IE", "findings", "HALF_TURN_TOL", "half_turn_symmetry",
-           "QUASI_STATIC_LIMITS", "quasi_static_check"]
+           "QUASI_STATIC_LIMITS", "quasi_static_check", "quasi_static_cause"]

@@ -225,6 +225,33 @@ def test_the_fit_moves_to_a_better_probe_of_its_final_jacobian(monkeypatch):
     assert not fit.converged and "Gauss-Newton" in fit.reason  # still about 0.25 from the truth
 
 
+def test_the_fit_moves_to_a_probe_of_its_sigma_check_that_fits_better(monkeypatch):
+    """Where the sigma check has run a law that fits better than the fit (by more than MOVE_RTOL),
+    the fit moves there: it reports that law, with its own Jacobian and a check there, and says
+    where it came from. The check is the real one, with a better law put among its probes on its
+    first call (here the truth, as the round trip at 8 mm met one at chi-square 118 beside 310);
+    the forming program is the linear stub (no forming run)."""
+    case, sec = _linear_stub(monkeypatch)
+    q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
+    real, calls = wf.checked_covariance, []
+
+    def check(rows, q, r, J, cov, lo, hi, **kw):
+        out = real(rows, q, r, J, cov, lo, hi, **kw)
+        calls.append(np.array(q, float))
+        if len(calls) == 1:  # a probe at the truth
+            chi = float(np.sum(rows(q_true) ** 2))
+            out[1]["lower"] = {"q": q_true.tolist(), "chi_square": chi, "fit_chi_square": float(r @ r), "significant": False}
+        return out
+
+    monkeypatch.setattr(wf, "checked_covariance", check)
+    fit = wf.fit_wrinkles(case, [sec], n_starts=1, max_iter=1, gradient_check=False)  # the optimiser stops early
+    moved = fit.sigma_check["moved_from"]
+    assert len(calls) == 2 and len(moved) == 1 and np.allclose(calls[1], q_true)  # checked again where it moved
+    assert np.allclose(moved[0]["q"], calls[0]) and moved[0]["chi_square"] > 1e3
+    assert np.allclose(fit.q, q_true) and fit.loss_final == pytest.approx(0.0, abs=1e-9)
+    assert fit.converged, fit.reason  # the optimiser ran out, but at the law moved to no Gauss-Newton step is left
+
+
 def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypatch):
     """Where the local fit from the best start ends in a local minimum (its chi-square beyond what
     the noise leaves at the true law), the fit runs the local phase again from the next-best starts

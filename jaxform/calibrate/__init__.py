@@ -7,7 +7,7 @@ the measured points, its curvature), :mod:`~jaxform.calibrate.cantilever_fit` (b
 shell cantilever, on ``scipy.optimize.least_squares``) and :mod:`~jaxform.calibrate.shear_fit`
 (shear laws, checked on the shell's picture frame), :mod:`~jaxform.calibrate.sections` (measured
 wrinkle sections and their position-tolerant residual), :mod:`~jaxform.calibrate.section_runs` (the
-forming runs behind them) and :mod:`~jaxform.calibrate.wrinkle_fit` (the bending law from wrinkle sections through the forming run, optionally with profiles). The scripts in ``calibration/`` and the readers
+forming runs behind them), :mod:`~jaxform.calibrate.starts` (the wrinkle fit's starting laws) and :mod:`~jaxform.calibrate.wrinkle_fit` (the bending law from wrinkle sections through the forming run, optionally with profiles). The scripts in ``calibration/`` and the readers
 in :mod:`jaxform.io.calibration_files` sit on top. SI units throughout.
 """
 from __future__ import annotations

@@ -233,23 +233,31 @@ def test_the_fit_moves_to_a_probe_of_its_sigma_check_that_fits_better(monkeypatc
     the forming program is the linear stub (no forming run)."""
     case, sec = _linear_stub(monkeypatch)
     q_true = wf.q_from_law(section_runs.SectionRuns(case, [sec], "voce", 1, 0.0, 1, 1).law0, "voce") + [0.3, 0.0, 0.3]
-    real, calls = wf.checked_covariance, []
+    real, calls, probe = wf.checked_covariance, [], {}
 
     def check(rows, q, r, J, cov, lo, hi, **kw):
         out = real(rows, q, r, J, cov, lo, hi, **kw)
         calls.append(np.array(q, float))
-        if len(calls) == 1:  # a probe at the truth
-            chi = float(np.sum(rows(q_true) ** 2))
-            out[1]["lower"] = {"q": q_true.tolist(), "chi_square": chi, "fit_chi_square": float(r @ r), "significant": False}
+        if len(calls) == 1:  # a better law among the probes
+            chi = float(np.sum(rows(probe["q"]) ** 2))
+            out[1]["lower"] = {"q": probe["q"].tolist(), "chi_square": chi, "fit_chi_square": float(r @ r),
+                               "significant": False}
         return out
 
     monkeypatch.setattr(wf, "checked_covariance", check)
-    fit = wf.fit_wrinkles(case, [sec], n_starts=1, max_iter=1, gradient_check=False)  # the optimiser stops early
+    kw = dict(n_starts=1, max_iter=1, gradient_check=False)  # the optimiser stops early
+    probe["q"] = q_true
+    fit = wf.fit_wrinkles(case, [sec], **kw)
     moved = fit.sigma_check["moved_from"]
     assert len(calls) == 2 and len(moved) == 1 and np.allclose(calls[1], q_true)  # checked again where it moved
     assert np.allclose(moved[0]["q"], calls[0]) and moved[0]["chi_square"] > 1e3
     assert np.allclose(fit.q, q_true) and fit.loss_final == pytest.approx(0.0, abs=1e-9)
     assert fit.converged, fit.reason  # the optimiser ran out, but at the law moved to no Gauss-Newton step is left
+    calls.clear()  # a better law that is not a minimum: moved to, and said so
+    probe["q"] = 0.5 * (q_true + moved[0]["q"])
+    fit = wf.fit_wrinkles(case, [sec], **kw)
+    assert np.allclose(fit.q, probe["q"]) and len(fit.sigma_check["moved_from"]) == 1 and not fit.converged
+    assert fit.reason.startswith("the fit moved to a better law its sigma check had run"), fit.reason
 
 
 def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypatch):

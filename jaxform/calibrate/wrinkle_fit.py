@@ -484,8 +484,9 @@ def _summarise(q, r, J, runs, prof, pn, params, sections, cuts, width, loss0, ch
     loss = 0.5 * chi2
     reasons = []
     if not converged:
-        reasons.append(f"the optimiser ({mode}) ran out of evaluations ({opt.nfev}) with a Gauss-Newton step still "
-                       f"removing {gn:.3g} of the chi-square")
+        reasons.append(("the fit moved to a better law its sigma check had run, where a Gauss-Newton step still removes "
+                        if moved else f"the optimiser ({mode}) ran out of evaluations ({opt.nfev}) with a Gauss-Newton "
+                        "step still removing ") + f"{gn:.3g} of the chi-square")
     if not loss < loss0:
         reasons.append("no law lowered the loss below the starting law's")
     at = [NAMES[i] for i in range(p) if q[i] <= lo[i] + 1e-6 or (q[i] >= hi[i] - 1e-6 and i != 1)]

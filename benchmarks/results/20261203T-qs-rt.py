@@ -1,5 +1,5 @@
 """Round trip of bench_wrinkle_fit at the automatic (quasi-static) speed, without the gradient check.
-Run: python 20261203T-qs-rt.py OUT.json. 20261203T-qs-rt-before-moves.json: at a78b477 (before the fit moved to a better probe); 20261203T-qs-rt.json: at 8343669.
+Run: python 20261203T-qs-rt.py OUT.json [NOISE_SEED, default 16; the argument since 2026-12-07]. 20261203T-qs-rt-before-moves.json: at a78b477 (before the fit moved to a better probe); 20261203T-qs-rt.json: at 8343669.
 """
 import dataclasses, json, sys, time
 import numpy as np
@@ -14,7 +14,7 @@ case = cases.resolve("case-a-woven-nlbm", element_size=8e-3, overrides=OVERRIDES
 print("speed", case.process.speed, flush=True)
 truth_case = dataclasses.replace(case, fabric=dataclasses.replace(case.fabric, voce=TRUTH))
 truth = VoceBending(*TRUTH)
-rng = np.random.default_rng(16)
+rng = np.random.default_rng(int(sys.argv[2]) if len(sys.argv) > 2 else 16)
 sections, _ = make_sections(truth_case, FIT_LINES, rng)
 held, held_clean = make_sections(truth_case, HELD_OUT, rng)
 t0 = time.perf_counter()

@@ -18,7 +18,8 @@ at high curvature.
 
 params.json: ``b_inf_Nm``, ``m0_N``, ``kappa0_per_m``, ``b_init_Nm``, ``shear_scale``, their
 ``sigma_*`` (Gauss-Newton / Laplace, checked against the loss along the covariance's principal
-axes, the flattest further out, and widened where it rises less: ``sigma_check``; plus the scatter of
+axes, the flattest further out, and widened where it rises less, the fit moved to a probe that fits
+better (``sigma_check.moved_from``): ``sigma_check``; plus the scatter of
 the fitted law's part from ``--scatter-seeds`` imperfect blanks: ``scatter``; ``null`` where no
 finite sd exists), ``determined`` (sd under 10 %, not a lower bound; ``b_inf``, ``m0``, ``kappa0`` only
 where the part bends to 5 kappa0), ``moment_band`` (M and its sd up to ``kappa_reach``, what

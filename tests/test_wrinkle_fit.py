@@ -258,6 +258,19 @@ def test_the_fit_moves_to_a_probe_of_its_sigma_check_that_fits_better(monkeypatc
     fit = wf.fit_wrinkles(case, [sec], **kw)
     assert np.allclose(fit.q, probe["q"]) and len(fit.sigma_check["moved_from"]) == 1 and not fit.converged
     assert fit.reason.startswith("the fit moved to a better law its sigma check had run"), fit.reason
+    # a law whose remaining Gauss-Newton gain is over 1 in raw chi-square but under one of the noise's
+    # degrees of freedom (the smoothed rows' misfit scale): converged, as the round trip's moved fit
+    R = S.weights([sec], wf.NOISE, float(case.element_size))
+    mean, var = S.chi_square_moments(R, wf.NOISE)
+    scale, unit = var / (2.0 * mean), float(np.sum((R @ np.full(31, 1e-3)) ** 2))  # chi-square of a 1-log-unit offset
+    assert scale > 4.0
+    calls.clear()
+    probe["q"] = q_true + np.array([math.sqrt(math.sqrt(scale) / unit), 0.0, 0.0])  # raw chi-square sqrt(scale)
+    fit = wf.fit_wrinkles(case, [sec], **kw)
+    d = fit.as_dict()
+    assert np.allclose(fit.q, probe["q"]) and fit.misfit["scale"] == pytest.approx(scale)
+    assert d["gn_decrease_chi2"] == pytest.approx(math.sqrt(scale), rel=1e-3) and d["gn_decrease_dof"] < 1.0
+    assert fit.converged, fit.reason
 
 
 def test_a_fit_in_a_local_minimum_runs_again_from_the_next_best_starts(monkeypatch):
@@ -397,6 +410,7 @@ def test_misfit_is_the_noise_s_own_chi_square_at_the_true_law():
     p = np.array([misfit(c, mean, var)["p_value"] for c in draws[:4000]])
     assert 0.005 <= np.mean(p < 0.01) <= 0.02
     assert misfit(130.0, 100.0, 200.0)["p_value"] == pytest.approx(chi2.sf(130.0, 100), rel=1e-9)
+    assert misfit(130.0, 100.0, 200.0)["scale"] == 1.0 and misfit(mean, mean, var)["scale"] > 4.0
     assert misfit(mean, mean, var)["consistent"]
     out = misfit(mean + 12.0 * math.sqrt(var), mean, var)
     assert not out["consistent"] and out["p_value"] < MISFIT_P

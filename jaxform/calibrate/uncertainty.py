@@ -258,14 +258,15 @@ def misfit(chi2: float, mean: float, var: float) -> dict:
     """How likely the measurement noise alone leaves a chi-square of at least ``chi2`` at the true
     law, where the rows' chi-square has mean ``mean`` and variance ``var`` there (correlated rows:
     smoothed sections): a scaled chi-square ``a chi2_k`` with those moments (``a = var / 2 mean``,
-    ``k = 2 mean^2 / var``). ``consistent``: ``p_value >= MISFIT_P``. A fit far above it sits in a
+    ``k = 2 mean^2 / var``; ``scale`` is ``a``: the chi-square of one effective degree of freedom, 1
+    for independent rows). ``consistent``: ``p_value >= MISFIT_P``. A fit far above it sits in a
     local minimum, has the wrong form of law, or was given too little noise; its Laplace standard
     deviations then describe that minimum only."""
     from scipy.stats import chi2 as scaled
 
     a, k = var / (2.0 * mean), 2.0 * mean * mean / var
     p = float(scaled.sf(chi2 / a, k))
-    return {"chi_square": float(chi2), "expected": float(mean), "sd": math.sqrt(var), "p_value": p,
+    return {"chi_square": float(chi2), "expected": float(mean), "sd": math.sqrt(var), "scale": float(a), "p_value": p,
             "limit": MISFIT_P, "consistent": p >= MISFIT_P}
 
 

@@ -29,7 +29,9 @@ wrinkles do determine), ``loss_initial``,
 ``iterations``, ``forming_runs``, ``wall_time_s``, ``misfit`` (the chi-square against what the noise
 leaves at the true law, as a whole and per block of data: ``blocks``, ``failed``), ``local_fits`` (each local fit: its start, final loss and misfit p; more than
 one where the first ended in a local minimum), ``cantilever_start`` (with profiles: the law they give
-alone, one of the starts), ``converged`` and ``reason``. An existing --out
+alone, one of the starts), ``gn_decrease_chi2`` and ``gn_decrease_dof`` (what a Gauss-Newton step
+from the fit would still gain, raw and in the noise's degrees of freedom: under 1 counts as
+converged), ``converged`` and ``reason``. An existing --out
 is never overwritten without --force.
 
 Exit status: 0 fitted; 1 a fit that is not to be used (params.json says ``converged: false`` and

@@ -1,6 +1,7 @@
 """``jaxform run``: outputs, refusal of a user's directory, interrupted and failed runs (coarse mesh)."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 import xml.etree.ElementTree as ET
@@ -100,6 +101,28 @@ def test_verify_quasi_static_runs_half_the_speed_and_records_the_check(tmp_out, 
     last_ok = max((i for i, v in enumerate(per) if v < 1.0), default=-1)  # before the trailing failures
     assert c["shear_agrees_to_punch_mm"] == (depth[last_ok] if last_ok >= 0 else None)
     assert ("part for good after" in text) is (max(per) >= 1.0)
+    # the same check from the two folders (a pair run apart): jaxform check-quasi-static, nothing run
+    half_dir, qs_json = tmp_out / "half_speed", tmp_out.parent / "qs.json"
+    assert main(["check-quasi-static", str(tmp_out), str(half_dir), "--json", str(qs_json)]) == (0 if verdict else 1)
+    d, text = json.loads(qs_json.read_text()), capsys.readouterr().out
+    for k in ("shear_p95_deg", "draw_in_edge_mid_rel", "half_speed_mm_per_s", "speed_mm_per_s", "shear_agrees_to_punch_mm"):
+        assert d[k] == pytest.approx(c[k], rel=1e-4, abs=1e-6), k  # the frames hold degrees, the run radians
+    assert d["shear_p95_deg_per_frame"] == pytest.approx(per, rel=1e-4, abs=1e-6) and d["punch_mm_per_frame"] == pytest.approx(depth)
+    assert (d["flange_wrinkles"], d["quasi_static"], d.get("cause")) == (c["flange_wrinkles"], c["quasi_static"], c.get("cause"))
+    assert "quasi-static check against half the speed (250 mm/s" in text
+    # refused: an existing --json, the same folder twice, a pair not at a speed and its half
+    assert main(["check-quasi-static", str(tmp_out), str(half_dir), "--json", str(qs_json)]) == 2
+    assert "refusing to overwrite" in capsys.readouterr().err
+    assert main(["check-quasi-static", str(tmp_out), str(tmp_out)]) == 2 and "given twice" in capsys.readouterr().err
+    other = tmp_out.parent / "other"
+    shutil.copytree(half_dir, other)
+    s_other = json.loads((other / "summary.json").read_text())
+    s_other["numerics"]["punch_speed_m_per_s"] = 0.3
+    (other / "summary.json").write_text(json.dumps(s_other))
+    assert main(["check-quasi-static", str(tmp_out), str(other)]) == 2 and "at half its speed (250 mm/s)" in capsys.readouterr().err
+    s_other["numerics"]["punch_speed_m_per_s"], s_other["inputs"]["process"]["stroke_mm"] = 0.25, 3.0
+    (other / "summary.json").write_text(json.dumps(s_other))
+    assert main(["check-quasi-static", str(tmp_out), str(other)]) == 2 and "process.stroke_mm" in capsys.readouterr().err
     # a rerun without the check removes the half-speed folder it left: never read as this run's
     assert main(["run", "case-a-woven-nlbm", "--out", str(tmp_out), *FAST]) == 0
     assert not (tmp_out / "half_speed").exists()

@@ -12,7 +12,7 @@ import sys
 import threading
 
 # Sub-command modules, in the order ``jaxform --help`` lists them.
-_COMMANDS = ("demo", "cases", "run", "sweep", "study", "wrinkles", "check")
+_COMMANDS = ("demo", "cases", "run", "sweep", "study", "wrinkles", "check", "quasi_static")
 
 
 def build_parser() -> argparse.ArgumentParser:

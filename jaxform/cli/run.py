@@ -164,7 +164,8 @@ def _remove_stale_half_speed(out):
         sub.rmdir()
 
 
-def _report_check(check, stream):
+def report_check(check, stream):
+    """Print a :func:`jaxform.forming.quasi_static_check` (``half_speed_dir`` in it) as ``jaxform run`` does."""
     lim = check.get("limits", {})
     if check.get("shear_p95_deg") is None:
         print(f"  quasi-static check: NOT made: {check.get('reason')}", file=stream)
@@ -215,7 +216,7 @@ def report(result, written, out, stream=None):
     for f in s.get("findings") or []:
         print(f"  {f['level']}: {f['text']}", file=stream)
     if "quasi_static_check" in s:
-        _report_check(s["quasi_static_check"], stream)
+        report_check(s["quasi_static_check"], stream)
     print(f"Wrote to {pathlib.Path(out).resolve()}:", file=stream)
     for p in written:
         print(f"  {p}", file=stream)

@@ -1,4 +1,5 @@
-"""What the paper study measures on one finished ``jaxform run`` folder (host side, numpy).
+"""What the paper study measures on one finished ``jaxform run`` folder (host side, numpy), and the
+quasi-static check of two such folders (:func:`quasi_static_check_dirs`).
 
 A run folder (``frames.pvd``, ``frames_#####.vtu``, ``summary.json``) is read back as a
 :class:`RunData`; :func:`measure_run` turns it into the figures the claims compare (JSON-ready
@@ -95,6 +96,57 @@ def load_run(folder) -> RunData:
     ply = np.asarray(m0.point_data["ply_id"]).astype(int).ravel()
     x_ref = x0 - np.asarray(m0.point_data["displacement_m"], float)
     return RunData(folder.name, folder, summary, case, faces, ply, x_ref, frames)
+
+
+def _as_result(run: RunData, speed: float):
+    """The part of a :class:`~jaxform.forming.driver.FormingResult` that
+    :func:`~jaxform.forming.quasi_static_check` reads, from the run's files (punch speed m/s)."""
+    from types import SimpleNamespace
+
+    shear = np.stack([np.radians(run.frame(k)[1]["shear_angle_deg"]) for k in range(len(run.frames))])
+    s = run.summary
+    return SimpleNamespace(info=SimpleNamespace(case=SimpleNamespace(process=SimpleNamespace(speed=speed)), x0=run.x_ref),
+                           complete=bool(s.get("complete")), reason=s.get("reason"), summary=s,
+                           t=np.array([f[0] for f in run.frames]), fields={"shear_angle": shear},
+                           history={k: np.asarray(v, float) for k, v in (s.get("history") or {}).items()
+                                    if k in ("t_s", "punch_displacement_m")})
+
+
+def quasi_static_check_dirs(run_dir, half_dir) -> dict:
+    """:func:`~jaxform.forming.quasi_static_check` of two finished ``jaxform run`` folders of one
+    case, the second run at half the first's punch speed: each frame's shear-angle map, and the
+    draw-in, flange wrinkles and half-turn symmetry of ``summary.json``. So a pair run apart (on
+    another day or machine) is certified as ``jaxform run --verify-quasi-static`` certifies the pair
+    it runs, without running either again. Raises ``ValueError`` where the two are not such a pair:
+    the same folder, inputs that differ beyond the speed, another speed ratio, other frames."""
+    from jaxform.forming import quasi_static_check
+    from jaxform.study.plan import differences
+
+    a, b = load_run(run_dir), load_run(half_dir)
+    if a.folder.resolve() == b.folder.resolve():
+        raise ValueError(f"{a.folder} given twice: give a run and the same case run at half its speed")
+    speeds, inputs = [], []
+    for r in (a, b):
+        v = (r.summary.get("numerics") or {}).get("punch_speed_m_per_s")
+        if not v:
+            raise ValueError(f"{r.folder}/summary.json records no punch speed (numerics.punch_speed_m_per_s)")
+        d = json.loads(json.dumps(r.summary.get("inputs") or {}))
+        d.pop("description", None)
+        d.get("process", {}).pop("speed_mm_per_s", None)
+        speeds.append(float(v))
+        inputs.append(d)
+    diff = differences(inputs[1], inputs[0], label=f"in {a.folder.name}")
+    if diff:
+        raise ValueError(f"{b.folder} ran other inputs than {a.folder} besides the speed: {'; '.join(diff[:3])}")
+    if abs(speeds[1] - 0.5 * speeds[0]) > 1e-6 * speeds[0]:
+        raise ValueError(f"{b.folder} ran at {1e3 * speeds[1]:g} mm/s and {a.folder} at {1e3 * speeds[0]:g} mm/s: the "
+                         f"check compares a run with one at half its speed ({0.5e3 * speeds[0]:g} mm/s)")
+    if len(a.frames) != len(b.frames):
+        raise ValueError(f"{a.folder} has {len(a.frames)} frames and {b.folder} {len(b.frames)}: the check compares "
+                         "them frame by frame")
+    check = quasi_static_check(_as_result(a, speeds[0]), _as_result(b, speeds[1]))
+    check.update(run_dir=str(a.folder), half_speed_dir=str(b.folder))
+    return check
 
 
 def sections(case) -> dict[str, tuple[np.ndarray, np.ndarray]]:
@@ -269,4 +321,4 @@ def measure_run(run: RunData, *, strokes=()) -> tuple[dict, dict]:
 
 
 __all__ = ["DOME_FRACTION", "EDGE_BAND", "SECTION_SAMPLES", "KAPPA_WRINKLE", "RunData", "about_x_axis", "load_run", "sections",
-           "measure_frame", "measure_run"]
+           "measure_frame", "measure_run", "quasi_static_check_dirs"]

@@ -115,14 +115,15 @@ def _comparable(inputs: dict) -> dict:
     return d
 
 
-def _differences(have: dict, want: dict, prefix: str = "") -> list[str]:
+def differences(have: dict, want: dict, prefix: str = "", label: str = "this study") -> list[str]:
+    """``"key = have (label: want)"`` for each leaf where two nested input dicts differ."""
     out = []
     for k in sorted(set(have) | set(want)):
         h, w = have.get(k), want.get(k)
         if isinstance(h, dict) and isinstance(w, dict):
-            out += _differences(h, w, f"{prefix}{k}.")
+            out += differences(h, w, f"{prefix}{k}.", label)
         elif h != w:
-            out.append(f"{prefix}{k} = {h!r} (this study: {w!r})")
+            out.append(f"{prefix}{k} = {h!r} ({label}: {w!r})")
     return out
 
 
@@ -139,7 +140,7 @@ def run_state(run: StudyRun, folder) -> tuple[bool, str]:
         return False, "not run"
     if not s.get("complete") and not failed_by_itself(s):
         return False, s.get("reason") or "not run"
-    diff = _differences(_comparable(s.get("inputs") or {}), _comparable(cases.to_dict(run.case())))
+    diff = differences(_comparable(s.get("inputs") or {}), _comparable(cases.to_dict(run.case())))
     if diff:
         return False, f"the run there has other inputs: {'; '.join(diff[:3])}"
     return True, "complete" if s.get("complete") else f"failed: {s.get('reason')}"
@@ -151,4 +152,5 @@ def finished(run: StudyRun, folder) -> str | None:
     return why if reusable else None
 
 
-__all__ = ["SETS", "SETTINGS", "FABRIC_SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "run_state", "finished"]
+__all__ = ["SETS", "SETTINGS", "FABRIC_SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "run_state", "finished",
+           "differences"]

@@ -120,7 +120,7 @@ def quasi_static_check_dirs(run_dir, half_dir) -> dict:
     it runs, without running either again. Raises ``ValueError`` where the two are not such a pair:
     the same folder, inputs that differ beyond the speed, another speed ratio, other frames."""
     from jaxform.forming import quasi_static_check
-    from jaxform.study.plan import differences
+    from jaxform.study.plan import comparable, differences
 
     a, b = load_run(run_dir), load_run(half_dir)
     if a.folder.resolve() == b.folder.resolve():
@@ -130,9 +130,8 @@ def quasi_static_check_dirs(run_dir, half_dir) -> dict:
         v = (r.summary.get("numerics") or {}).get("punch_speed_m_per_s")
         if not v:
             raise ValueError(f"{r.folder}/summary.json records no punch speed (numerics.punch_speed_m_per_s)")
-        d = json.loads(json.dumps(r.summary.get("inputs") or {}))
-        d.pop("description", None)
-        d.get("process", {}).pop("speed_mm_per_s", None)
+        d = comparable(r.summary.get("inputs") or {})
+        d.get("process", {}).pop("speed_mm_per_s", None)  # the one input the pair differs in
         speeds.append(float(v))
         inputs.append(d)
     diff = differences(inputs[1], inputs[0], label=f"in {a.folder.name}")

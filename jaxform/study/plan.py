@@ -109,7 +109,8 @@ def failed_by_itself(m: dict) -> bool:
     return not m.get("complete") and not reason.startswith(NOT_ENDED) and "terminated" not in reason
 
 
-def _comparable(inputs: dict) -> dict:
+def comparable(inputs: dict) -> dict:
+    """A deep copy of a run's ``inputs`` without what does not change the run (its description)."""
     d = json.loads(json.dumps(inputs))
     d.pop("description", None)
     return d
@@ -140,7 +141,7 @@ def run_state(run: StudyRun, folder) -> tuple[bool, str]:
         return False, "not run"
     if not s.get("complete") and not failed_by_itself(s):
         return False, s.get("reason") or "not run"
-    diff = differences(_comparable(s.get("inputs") or {}), _comparable(cases.to_dict(run.case())))
+    diff = differences(comparable(s.get("inputs") or {}), comparable(cases.to_dict(run.case())))
     if diff:
         return False, f"the run there has other inputs: {'; '.join(diff[:3])}"
     return True, "complete" if s.get("complete") else f"failed: {s.get('reason')}"
@@ -153,4 +154,4 @@ def finished(run: StudyRun, folder) -> str | None:
 
 
 __all__ = ["SETS", "SETTINGS", "FABRIC_SETTINGS", "RUNS_DIR", "NOT_ENDED", "failed_by_itself", "StudyRun", "plan", "run_state", "finished",
-           "differences"]
+           "comparable", "differences"]

@@ -47,7 +47,9 @@ def row_forces(p, mass, h, dt, nodes, weights, normal, gap, area, stiffness, dam
         h: () the step over which the force acts (half a step on the first), s; dt: () the step
             that moves the positions, s.
         nodes: (R, K) int node indices of each row; weights: (R, K) their weights ``w`` (0 for an
-            unused slot).
+            unused slot); both ``None``: row ``r`` is node ``r`` alone with weight 1 (``R = N``: a
+            node on a rigid tool), the same arithmetic without the gathers and the scatter-adds (a
+            third of a 4 mm step on CPU for the three tools of Case A).
         normal: (R, 3) unit normals (the force on the row's first node points along it).
         gap: (R,) gaps at the start of the step, m; area: (R,) areas, m² (0: the row is off).
         stiffness: () penalty ``k``, Pa/m; damping: () normal damping ``c``, Pa·s/m.
@@ -59,6 +61,14 @@ def row_forces(p, mass, h, dt, nodes, weights, normal, gap, area, stiffness, dam
     """
     m = jnp.asarray(mass, p.dtype)
     v = p / m[:, None]
+    if nodes is None:  # one node a row, weight 1: w = S_i = 1 where the row is on, so 1 / m_r = 1 / m_r's node
+        u_star = jnp.sum(v * normal, axis=1)
+        if velocity is not None:
+            u_star = u_star - jnp.sum(velocity * normal, axis=1)
+        p_star = -stiffness * (gap + dt * u_star) - damping * u_star
+        on = (p_star > 0) & (area > 0)
+        f = jnp.where(on, area * p_star / (1.0 + h * area * (stiffness * dt + damping) * jnp.where(on, 1.0 / m, 0.0)), 0.0)
+        return f, f[:, None] * normal
     vn = jnp.einsum("rkc,rc->rk", v[nodes], normal)  # (R, K) each node's velocity along the row's normal
     u_star = jnp.sum(weights * vn, axis=1)
     if velocity is not None:

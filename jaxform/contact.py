@@ -416,10 +416,8 @@ class ToolLoad:
         f_n = jnp.zeros_like(p)
         if self.implicit_normal:
             g, normal, area, vel = support
-            n = p.shape[0]
-            _, f_n = backward_normal.row_forces(p, mass, h, dt, jnp.arange(n)[:, None], jnp.ones((n, 1), p.dtype), normal,
-                                                g, area, self.params.stiffness, self.params.damping,
-                                                jnp.broadcast_to(vel, (n, 3)))
+            _, f_n = backward_normal.row_forces(p, mass, h, dt, None, None, normal, g, area, self.params.stiffness,
+                                                self.params.damping, jnp.broadcast_to(vel, p.shape))
             p, f_normal = p + h * f_n, f_n
         else:
             f_normal, vel = support

@@ -182,3 +182,25 @@ def test_where_two_rows_press_a_node_from_both_sides_the_penetration_grows_with_
         z, F = jax.jit(settle)(k)
         assert np.asarray(F) == pytest.approx([f, f], rel=1e-4)
         assert -float(z) * AREA * k / f == pytest.approx(1 + 2 * beta, rel=1e-3)
+
+
+def test_one_node_a_row_without_the_index_tables_gives_the_rows_forces():
+    """``row_forces(nodes=None, weights=None)`` (a tool's contact: row r is node r, weight 1) is the
+    general rows' arithmetic without gathers and scatter-adds: the same forces (float64, random
+    momenta, gaps on both sides of contact, rows off by area, a moving tool)."""
+    rng = np.random.default_rng(3)
+    n = 400
+    p = jnp.asarray(rng.normal(scale=1e-6, size=(n, 3)))
+    mass = jnp.asarray(rng.uniform(0.5, 2.0, n) * M)
+    normal = rng.normal(size=(n, 3))
+    normal = jnp.asarray(normal / np.linalg.norm(normal, axis=1, keepdims=True))
+    gap = jnp.asarray(rng.normal(scale=2e-5, size=n))
+    area = jnp.asarray(AREA * rng.uniform(0.5, 1.0, n) * (rng.uniform(size=n) > 0.2))
+    vel = jnp.broadcast_to(jnp.asarray([0.0, 0.0, -0.0625]), (n, 3))
+    args = (1e-5, 1e-5)
+    f_rows, F_rows = backward_normal.row_forces(p, mass, *args, jnp.arange(n)[:, None], jnp.ones((n, 1)), normal, gap, area,
+                                                3e8, 20.0, vel)
+    f_node, F_node = backward_normal.row_forces(p, mass, *args, None, None, normal, gap, area, 3e8, 20.0, vel)
+    assert 0.2 * n < int(jnp.sum(f_rows > 0)) < 0.8 * n  # both sides of contact present
+    np.testing.assert_allclose(f_node, f_rows, rtol=1e-12, atol=1e-18)
+    np.testing.assert_allclose(F_node, F_rows, rtol=1e-12, atol=1e-18)

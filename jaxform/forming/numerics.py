@@ -69,6 +69,14 @@ STEP_BUDGET = 0.9
 """The explicit step's budget: ``omega dt <= 2 x STEP_BUDGET`` at the stiffest node, its shell and
 its contacts together (``omega^2`` adds up: the largest eigenvalue of ``M^-1 (K_shell + K_contact)``
 is at most the sum of theirs); the margin below 2 covers the contacts' normal damping."""
+EXPLICIT_STEP = 0.75
+"""The step as a fraction of the shell's stable step where the contacts' normal forces are explicit:
+the rest of the budget (:data:`STEP_BUDGET`) is the contacts' room, 0.2475 of safety with
+:data:`STACKED_CONTACTS` of them on a node."""
+BACKWARD_STEP = STEP_BUDGET
+"""The step as a fraction of the shell's stable step where the contacts' normal forces are integrated
+backward (:mod:`jaxform.backward_normal`): they take nothing from the step, so the shell has the
+whole budget (``omega dt / 2 = 0.9`` at its stiffest mode), 1.2x the explicit :data:`EXPLICIT_STEP`."""
 STACKED_CONTACTS = 4
 """Contact springs counted on one node: a node of a layer pressed between two others (a fold
 under the holder, a stack) has two, and the highest mode of a chain of such layers approaches
@@ -139,7 +147,8 @@ class ContactNumerics:
     implicit_normal: bool = False
 
 
-def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float, implicit: bool) -> ContactNumerics:
+def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float | None,
+            implicit: bool) -> ContactNumerics:
     """Choose the time step and the contact safety together (the automatic numerics of contact),
     with the contacts' normal forces explicit or, ``implicit``, backward.
 
@@ -147,14 +156,16 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
     ``f`` :data:`MAX_PENETRATION`), and the
     step stable with :data:`STACKED_CONTACTS` contacts on a node: ``(omega_s dt)^2 + n_c safety <=
     (2 STEP_BUDGET)^2`` with ``omega_s = 2 / stable`` the shell's (fibre mass included) and
-    ``safety = k dt^2 / rho_A``. Automatic safety (``contact.safety = "auto"``): the step is
-    ``dt_safety x stable`` and the safety the room the shell leaves in the budget
+    ``safety = k dt^2 / rho_A``. ``dt_safety`` (default :data:`EXPLICIT_STEP`, with the normal
+    backward :data:`BACKWARD_STEP`): the step's fraction of ``stable``. Automatic safety
+    (``contact.safety = "auto"``): the step is ``dt_safety x stable`` and the safety the room the shell leaves in the budget
     (``((2 STEP_BUDGET)^2 - (omega_s dt)^2) / n_c``: 0.2475 at ``dt_safety`` 0.75; at least
     :data:`AUTO_SAFETY`) where that is stiff enough for ``k_need``: the stiffest contact the step
     allows, at no cost (a softer one only penetrates deeper: NCF Case A at 4 mm with 0.1 sank
     0.132 h into a tool, beyond the 0.1 h the penalty is chosen for); beyond that the step shrinks to
     ``dt = 2 STEP_BUDGET / sqrt(omega_s^2 + n_c k_need / rho_A)`` with ``k = k_need`` (2% above
-    the limit). A given
+    the limit). Backward (``implicit``): any stiffness is stable, so the step is the shell's alone
+    and the penalty at least as stiff as the explicit rule's at its own step (and ``k_need``). A given
     safety or stiffness is kept (the step capped so that ``k >= k_need`` as before), and a budget
     above 1 is reported (``budget``) and warned about.
     """
@@ -182,10 +193,14 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
             s_ = float(c.penalty_stiffness) * float(dt) ** 2 / rho
         return ContactNumerics(float(dt), c.safety if c.safety is not None else AUTO_SAFETY, "user",
                                budget(float(dt), 0.0 if implicit else s_), "the time step was given", implicit)
+    if dt_safety is None:
+        dt_safety = BACKWARD_STEP if implicit else EXPLICIT_STEP
     dt0 = dt_safety * stable
     if implicit and c.safety is None:  # the contact takes nothing from the step (jaxform.backward_normal)
-        s_ = (c.penalty_stiffness * dt0**2 / rho if c.penalty_stiffness is not None else
-              max(k_need * dt0**2 / rho, (lim - w_s2 * dt0**2) / n_c, AUTO_SAFETY))
+        dt_e = EXPLICIT_STEP * stable  # the explicit rule's step and room: a contact at least as stiff as that one
+        k = (c.penalty_stiffness if c.penalty_stiffness is not None else
+             max(k_need, max(AUTO_SAFETY, (lim - w_s2 * dt_e**2) / n_c) * rho / dt_e**2))
+        s_ = k * dt0**2 / rho
         return ContactNumerics(dt0, s_, "shell", 0.5 * math.sqrt(w_s2) * dt0,
                                f"step {dt_safety:g} x the shell's stable step; the contacts' normal forces integrated "
                                f"backward (any stiffness stable): safety {s_:.3g} (penetration below "
@@ -215,30 +230,33 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
                            f"{dt_:.3g} s (shell: {dt0:.3g} s); contact safety {s_:.3g}", implicit)
 
 
-def contact_numerics(case: Case, fabrics, stable: float, dt: float | None, dt_safety: float) -> ContactNumerics:
+def contact_numerics(case: Case, fabrics, stable: float, dt: float | None,
+                     dt_safety: float | None = None) -> ContactNumerics:
     """Choose the time step, the contact safety and how the contacts' normal forces are integrated.
 
     ``contact.implicit_normal = "auto"`` (the default): integrated backward
-    (:mod:`jaxform.backward_normal`, the contact then takes nothing from the step) where the
-    explicit contact would set the step (``governed_by == "contact"``: the shell would allow a
-    longer one) and the backward normal holds, i.e. one ply under a holder at a fixed gap, with the
-    step and the contact's safety and stiffness automatic; explicit everywhere else (the shell sets
-    the step: nothing to gain; a clamped holder or a stack: refused, :func:`_choose`). Woven Case A at
-    8 mm: 35,600 steps of 2.36e-5 s instead of 48,000 of 1.75e-5 s, the same result within the
-    quasi-static tolerances (README, "Contact normal forces integrated backward"); at 4 and 2 mm and
-    for the NCF (fibre-mass factor 3) the shell sets the step and the contact stays explicit.
-    ``true``/``false`` are kept as given. The explicit and backward choices: :func:`_choose`."""
+    (:mod:`jaxform.backward_normal`) wherever that holds, i.e. one ply under a holder at a fixed gap
+    with the step and the contact's safety and stiffness automatic: the contact then takes nothing
+    from the step, which is :data:`BACKWARD_STEP` (0.9) of the shell's stable step against the
+    explicit rule's :data:`EXPLICIT_STEP` (0.75; less where a stiff enough contact sets it), with a
+    penalty at least as stiff as the explicit rule's. Explicit everywhere else (a clamped holder or a
+    stack: refused, :func:`_choose`; a given step, safety or stiffness). Woven Case A at 8 mm, where
+    the explicit contact set the step: 35,600 steps of 2.36e-5 s instead of 48,000 of 1.75e-5 s at
+    0.75 (README, "Contact normal forces integrated backward"), now 0.9. ``true``/``false`` are kept
+    as given. ``dt_safety``: the step's fraction of ``stable`` (default by the integration chosen).
+    The explicit and backward choices: :func:`_choose`."""
     c = case.contact
     if c.implicit_normal is not None:
         return _choose(case, fabrics, stable, dt, dt_safety, bool(c.implicit_normal))
     n = _choose(case, fabrics, stable, dt, dt_safety, False)
-    if (n.governed_by != "contact" or case.holder.mode != "gap" or case.n_plies != 1 or c.safety is not None
+    if (dt is not None or case.holder.mode != "gap" or case.n_plies != 1 or c.safety is not None
             or c.penalty_stiffness is not None):
         return n
     m = _choose(case, fabrics, stable, dt, dt_safety, True)
-    return dataclasses.replace(m, why=f"{m.why} (contact.implicit_normal auto: the explicit contact would "
-                                      f"have set the step to {n.dt_max:.3g} s)")
+    return dataclasses.replace(m, why=f"{m.why} (contact.implicit_normal auto; the explicit contact: "
+                                      f"{n.dt_max:.3g} s)")
 
 
-__all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "STACKED_CONTACTS",
+__all__ = ["FIBRE_MASS_MAX", "FIBRE_MASS_MAX_OFF_AXIS", "FIBRE_MASS_RESERVE", "auto_fibre_mass", "STEP_BUDGET", "EXPLICIT_STEP",
+           "BACKWARD_STEP", "STACKED_CONTACTS",
            "AUTO_SAFETY", "GAP_EXPECTED_PRESSURE", "STIFFEN_PENETRATION", "CONTACT_STIFFEN", "CONTACT_RAMP", "expected_pressure", "ContactNumerics", "contact_numerics"]

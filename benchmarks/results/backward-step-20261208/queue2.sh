@@ -1,0 +1,11 @@
+#!/bin/bash
+J=/work/main/.venv/bin/jaxform
+run() { local label=$1 code=$2; shift 2; local start=$(date +%s)
+  if [ "$code" = base ]; then (cd /tmp/base && PYTHONPATH=/tmp/base $J run "$@" > /tmp/v/$label.log 2>&1); else (cd /work/main && $J run "$@" > /tmp/v/$label.log 2>&1); fi
+  echo "rc=$? wall=$(( $(date +%s)-start ))s" >> /tmp/v/$label.log; }
+run new-w4b new case-a-woven-nlbm --element-size-mm 4 --out /tmp/v/new-w4b
+run base-w4b base case-a-woven-nlbm --element-size-mm 4 --out /tmp/v/base-w4b
+run new-w2 new case-a-woven-nlbm --out /tmp/v/new-w2
+run base-w2 base case-a-woven-nlbm --out /tmp/v/base-w2
+run new-n4 new case-a-ncf-nlbm --element-size-mm 4 --out /tmp/v/new-n4
+echo done > /tmp/v/queue2.done

@@ -1,4 +1,4 @@
-import time, sys, jax, jax.numpy as jnp, meshio
+import time, jax, jax.numpy as jnp, meshio
 from jaxform import cases, broadphase
 from jaxform.forming import rig as rigmod
 case = cases.with_element_size(cases.load("case-a-woven-nlbm"), 2e-3)

@@ -61,24 +61,25 @@ def row_forces(p, mass, h, dt, nodes, weights, normal, gap, area, stiffness, dam
     """
     m = jnp.asarray(mass, p.dtype)
     v = p / m[:, None]
-    if nodes is None:  # one node a row, weight 1: w = S_i = 1 where the row is on, so 1 / m_r = 1 / m_r's node
+    one = nodes is None  # one node a row, weight 1: w = S_i = 1 where the row is on, so 1 / m_r = 1 / m_r's node
+    if one:
         u_star = jnp.sum(v * normal, axis=1)
-        if velocity is not None:
-            u_star = u_star - jnp.sum(velocity * normal, axis=1)
-        p_star = -stiffness * (gap + dt * u_star) - damping * u_star
-        on = (p_star > 0) & (area > 0)
-        f = jnp.where(on, area * p_star / (1.0 + h * area * (stiffness * dt + damping) * jnp.where(on, 1.0 / m, 0.0)), 0.0)
-        return f, f[:, None] * normal
-    vn = jnp.einsum("rkc,rc->rk", v[nodes], normal)  # (R, K) each node's velocity along the row's normal
-    u_star = jnp.sum(weights * vn, axis=1)
+    else:
+        vn = jnp.einsum("rkc,rc->rk", v[nodes], normal)  # (R, K) each node's velocity along the row's normal
+        u_star = jnp.sum(weights * vn, axis=1)
     if velocity is not None:
         u_star = u_star - jnp.sum(velocity * normal, axis=1)
     p_star = -stiffness * (gap + dt * u_star) - damping * u_star
     on = (p_star > 0) & (area > 0)
-    aw = jnp.where(on[:, None], jnp.abs(weights), 0.0)
-    split = jnp.zeros_like(m).at[nodes.reshape(-1)].add(aw.reshape(-1))  # S_i
-    inv_m = jnp.sum(aw * split[nodes] / m[nodes], axis=1)  # 1 / m_r (0 for rows that are off)
+    if one:
+        inv_m = jnp.where(on, 1.0 / m, 0.0)
+    else:
+        aw = jnp.where(on[:, None], jnp.abs(weights), 0.0)
+        split = jnp.zeros_like(m).at[nodes.reshape(-1)].add(aw.reshape(-1))  # S_i
+        inv_m = jnp.sum(aw * split[nodes] / m[nodes], axis=1)  # 1 / m_r (0 for rows that are off)
     f = jnp.where(on, area * p_star / (1.0 + h * area * (stiffness * dt + damping) * inv_m), 0.0)
+    if one:
+        return f, f[:, None] * normal
     force = jnp.zeros_like(p).at[nodes.reshape(-1)].add(
         ((f[:, None] * weights)[:, :, None] * normal[:, None, :]).reshape(-1, 3))
     return f, force

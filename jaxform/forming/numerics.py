@@ -180,6 +180,9 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
     def budget(dt_, s_):
         return 0.5 * math.sqrt(w_s2 * dt_**2 + n_c * s_)
 
+    def room(dt_):  # the safety the shell leaves the contacts in the budget at step dt_ (at least AUTO_SAFETY)
+        return max(AUTO_SAFETY, (lim - w_s2 * dt_**2) / n_c)
+
     if implicit and (case.holder.mode == "force" or case.n_plies > 1):
         raise ValueError(
             "contact.implicit_normal = true: not with a clamped holder (holder.mode = 'force') or a stack of "
@@ -198,8 +201,7 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
     dt0 = dt_safety * stable
     if implicit and c.safety is None:  # the contact takes nothing from the step (jaxform.backward_normal)
         dt_e = EXPLICIT_STEP * stable  # the explicit rule's step and room: a contact at least as stiff as that one
-        k = (c.penalty_stiffness if c.penalty_stiffness is not None else
-             max(k_need, max(AUTO_SAFETY, (lim - w_s2 * dt_e**2) / n_c) * rho / dt_e**2))
+        k = c.penalty_stiffness if c.penalty_stiffness is not None else max(k_need, room(dt_e) * rho / dt_e**2)
         s_ = k * dt0**2 / rho
         return ContactNumerics(dt0, s_, "shell", 0.5 * math.sqrt(w_s2) * dt0,
                                f"step {dt_safety:g} x the shell's stable step; the contacts' normal forces integrated "
@@ -216,9 +218,8 @@ def _choose(case: Case, fabrics, stable: float, dt: float | None, dt_safety: flo
                                budget(dt_, 0.0 if implicit else c.safety),
                                f"contact.safety = {c.safety:g} was given", implicit)
     s_need = k_need * dt0**2 / rho
-    s_room = (lim - w_s2 * dt0**2) / n_c
-    if s_need <= max(AUTO_SAFETY, s_room):
-        s_ = max(AUTO_SAFETY, s_room)  # the room the shell leaves in the budget: the stiffest contact at no step cost
+    if s_need <= room(dt0):
+        s_ = room(dt0)  # the room the shell leaves in the budget: the stiffest contact at no step cost
         return ContactNumerics(dt0, s_, "shell", budget(dt0, s_),
                                f"step {dt_safety:g} x the shell's stable step; contact safety {s_:.3g} "
                                f"(penetration below {MAX_PENETRATION:g} h at {p_exp:.3g} Pa)", implicit)
